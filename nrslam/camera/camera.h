@@ -1,0 +1,67 @@
+// camera: a camera model with its intrinsics and image size.
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nrslam/camera/camera_models.h"
+
+namespace nrslam {
+
+class Camera {
+ public:
+  Camera() = default;  // an invalid camera; Check() throws
+  static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
+  static Camera KannalaBrandt(int width, int height, double fx, double fy, double cx, double cy,
+                              const Eigen::Vector4d& k);
+
+  CameraModelId model() const { return model_; }
+  std::string model_name() const;
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const std::vector<double>& params() const { return params_; }
+  double fx() const { return params_[0]; }
+  double fy() const { return params_[1]; }
+  double cx() const { return params_[2]; }
+  double cy() const { return params_[3]; }
+
+  // Largest angle from the optical axis the model maps one-to-one (rad): π/2 for pinhole,
+  // the end of the monotonic part of r(θ) for Kannala–Brandt (at most π).
+  double max_theta() const { return max_theta_; }
+
+  // Pixel of a point in camera coordinates; nullopt when the point is behind the camera
+  // or outside the model's field of view. The pixel may still lie outside the image.
+  std::optional<Eigen::Vector2d> Project(const Eigen::Vector3d& point) const;
+  // Unit bearing of a pixel; beyond a fisheye's image circle, the bearing at max_theta().
+  Eigen::Vector3d Unproject(const Eigen::Vector2d& pixel) const;
+  // d pixel / d point at `point` (camera coordinates).
+  Eigen::Matrix<double, 2, 3> ProjectionJacobian(const Eigen::Vector3d& point) const;
+
+  bool InImage(const Eigen::Vector2d& pixel, double margin = 0.0) const {
+    return pixel.x() >= margin && pixel.y() >= margin && pixel.x() <= width_ - 1 - margin &&
+           pixel.y() <= height_ - 1 - margin;
+  }
+  // Mean focal length (px); its inverse is the angular size of a pixel at the centre.
+  double MeanFocal() const { return 0.5 * (fx() + fy()); }
+
+  // Throws Error naming the first thing wrong (non-positive size, negative focal length, ...).
+  void Check() const;
+
+ private:
+  CameraModelId model_ = CameraModelId::kPinhole;
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<double> params_;
+  double max_theta_ = 0.0;
+  void ComputeMaxTheta();
+};
+
+void to_json(nlohmann::json& j, const Camera& camera);
+// Validates (Check()) and throws Error on unknown model or missing fields.
+void from_json(const nlohmann::json& j, Camera& camera);
+
+}  // namespace nrslam

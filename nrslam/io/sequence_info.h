@@ -1,0 +1,37 @@
+// io: the description of a sequence, as stored in its sequence.json.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+
+#include "nrslam/camera/camera.h"
+
+namespace nrslam {
+
+struct StereoInfo {
+  double baseline_mm = 0.0;  // right camera = left translated by +baseline along camera x
+  Camera right_camera;
+};
+
+struct SequenceInfo {
+  Camera camera;
+  double fps = 30.0;
+  int frame_count = 0;
+  double depth_unit_mm = 0.01;  // a depth PNG value v means v * depth_unit_mm millimetres
+  std::optional<StereoInfo> stereo;
+  std::string mask;             // optional fixed validity mask, path relative to the folder
+  nlohmann::json provenance = nlohmann::json::object();  // generator and its parameters
+
+  // Throws Error naming the first invalid field.
+  void Check() const;
+};
+
+void to_json(nlohmann::json& j, const SequenceInfo& info);
+void from_json(const nlohmann::json& j, SequenceInfo& info);
+
+// "000037.png": the file name of frame `index` in every per-frame folder.
+std::string FrameFileName(int index);
+
+}  // namespace nrslam

@@ -1,0 +1,65 @@
+#include "nrslam/io/sequence_writer.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <fstream>
+
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace fs = std::filesystem;
+
+SequenceWriter::SequenceWriter(const fs::path& folder, const SequenceInfo& info, bool with_depth)
+    : folder_(folder), info_(info) {
+  info_.Check();
+  std::error_code error;
+  fs::create_directories(folder / "rgb", error);
+  if (with_depth) fs::create_directories(folder / "depth", error);
+  if (info.stereo) fs::create_directories(folder / "right", error);
+  if (error) throw Error("cannot create " + folder.string() + ": " + error.message());
+  std::ofstream file(folder / "sequence.json");
+  if (!file) throw Error("cannot write " + (folder / "sequence.json").string());
+  file << nlohmann::json(info_).dump(2) << '\n';
+}
+
+void SequenceWriter::WritePng(const fs::path& path, const cv::Mat& image) const {
+  // Fast compression: the simulator writes tens of thousands of frames; size matters less.
+  if (!cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw Error("cannot write " + path.string());
+  }
+}
+
+void SequenceWriter::WriteRgb(int index, const cv::Mat& bgr) const {
+  WritePng(folder_ / "rgb" / FrameFileName(index), bgr);
+}
+
+void SequenceWriter::WriteRight(int index, const cv::Mat& bgr) const {
+  WritePng(folder_ / "right" / FrameFileName(index), bgr);
+}
+
+void SequenceWriter::WriteDepthMm(int index, const cv::Mat& depth_mm) const {
+  CV_Assert(depth_mm.type() == CV_32F);
+  cv::Mat encoded(depth_mm.size(), CV_16UC1);
+  const double inverse_unit = 1.0 / info_.depth_unit_mm;
+  for (int y = 0; y < depth_mm.rows; ++y) {
+    const float* in = depth_mm.ptr<float>(y);
+    uint16_t* out = encoded.ptr<uint16_t>(y);
+    for (int x = 0; x < depth_mm.cols; ++x) {
+      const double value = std::isfinite(in[x]) ? std::round(in[x] * inverse_unit) : 0.0;
+      out[x] = (value > 0 && value <= 65535) ? static_cast<uint16_t>(value) : 0;
+    }
+  }
+  WritePng(folder_ / "depth" / FrameFileName(index), encoded);
+}
+
+void SequenceWriter::WriteFixedMask(const cv::Mat& mask) const {
+  if (info_.mask.empty()) throw Error("sequence.json names no mask file");
+  WritePng(folder_ / info_.mask, mask);
+}
+
+void SequenceWriter::WriteGroundtruth(const std::vector<StampedPose>& poses) const {
+  WriteTum(folder_ / "groundtruth.tum", poses);
+}
+
+}  // namespace nrslam

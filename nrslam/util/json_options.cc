@@ -1,0 +1,116 @@
+#include "nrslam/util/json_options.h"
+
+#include <sstream>
+
+namespace nrslam {
+namespace {
+
+void CollectLeafPaths(const Json& node, const std::string& prefix, std::vector<std::string>* out) {
+  if (!node.is_object()) {
+    out->push_back(prefix);
+    return;
+  }
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    CollectLeafPaths(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
+  }
+}
+
+void CollectUnknown(const Json& given, const Json& reference, const std::string& prefix,
+                    std::vector<std::string>* unknown) {
+  if (!given.is_object() || !reference.is_object()) return;
+  for (auto it = given.begin(); it != given.end(); ++it) {
+    const std::string path = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (!reference.contains(it.key())) {
+      unknown->push_back(path);
+    } else {
+      CollectUnknown(it.value(), reference.at(it.key()), path, unknown);
+    }
+  }
+}
+
+std::string Join(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
+  return out;
+}
+
+Json ParseLike(const Json& existing, const std::string& text, const std::string& path) {
+  try {
+    size_t used = 0;
+    switch (existing.type()) {
+      case Json::value_t::number_integer:
+      case Json::value_t::number_unsigned: {
+        const long long value = std::stoll(text, &used);
+        if (used != text.size()) break;
+        return value;
+      }
+      case Json::value_t::number_float: {
+        const double value = std::stod(text, &used);
+        if (used != text.size()) break;
+        return value;
+      }
+      case Json::value_t::boolean:
+        if (text == "true" || text == "1" || text == "on") return true;
+        if (text == "false" || text == "0" || text == "off") return false;
+        break;
+      case Json::value_t::string:
+        return text;
+      case Json::value_t::array: {
+        const std::string as_json = text.front() == '[' ? text : "[" + text + "]";
+        Json value = Json::parse(as_json);
+        if (!existing.empty() && value.size() != existing.size()) break;
+        return value;
+      }
+      default:
+        break;
+    }
+  } catch (const std::exception&) {
+  }
+  std::ostringstream message;
+  message << "option " << path << ": cannot use '" << text << "' (expected "
+          << existing.type_name() << ", like " << existing.dump() << ")";
+  throw Error(message.str());
+}
+
+}  // namespace
+
+std::vector<std::string> LeafPaths(const Json& config) {
+  std::vector<std::string> paths;
+  CollectLeafPaths(config, "", &paths);
+  return paths;
+}
+
+void RejectUnknownKeys(const Json& given, const Json& reference, const std::string& context) {
+  if (!given.is_object()) throw Error(context + ": expected a JSON object");
+  std::vector<std::string> unknown;
+  CollectUnknown(given, reference, "", &unknown);
+  if (!unknown.empty()) {
+    throw Error(context + ": unknown option(s) " + Join(unknown, ", ") +
+                "; known options: " + Join(LeafPaths(reference), ", "));
+  }
+}
+
+void ApplyAssignment(Json& config, const std::string& assignment) {
+  const size_t equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    throw Error("option assignment '" + assignment + "' must look like name=value");
+  }
+  const std::string path = assignment.substr(0, equals);
+  const std::string text = assignment.substr(equals + 1);
+  Json* node = &config;
+  std::stringstream parts(path);
+  std::string key;
+  while (std::getline(parts, key, '.')) {
+    if (!node->is_object() || !node->contains(key)) {
+      throw Error("unknown option '" + path + "'; known options: " + Join(LeafPaths(config), ", "));
+    }
+    node = &(*node)[key];
+  }
+  if (node->is_object()) {
+    throw Error("option '" + path + "' is a group; set one of its fields: " +
+                Join(LeafPaths(*node), ", "));
+  }
+  *node = ParseLike(*node, text, path);
+}
+
+}  // namespace nrslam

@@ -1,0 +1,59 @@
+// util: JSON round-trip and command-line overrides for options structs.
+//
+// Every module keeps its tunables in one options struct with defaults, a Check() and
+// nlohmann to_json/from_json. These helpers give all of them the same behaviour:
+// unknown keys are errors (a typo in a sweep must not silently run the default), and any
+// field can be set from the command line as `path.to.field=value`, parsed with the type
+// the field already has.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+
+using Json = nlohmann::json;
+
+// Throws Error naming every key of `given` that `reference` (the serialised defaults) lacks.
+void RejectUnknownKeys(const Json& given, const Json& reference, const std::string& context);
+
+// Applies one `a.b.c=value` assignment to `config`. The key must already exist; the value is
+// parsed as the existing value's type (integer, number, bool, string, or a JSON/comma list
+// for arrays). Throws Error with the known keys when the path is unknown.
+void ApplyAssignment(Json& config, const std::string& assignment);
+
+// All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
+std::vector<std::string> LeafPaths(const Json& config);
+
+// Parses options from JSON on top of the defaults, rejecting unknown keys, then Check()s.
+template <typename Options>
+Options OptionsFromJson(const Json& given, const std::string& context) {
+  const Json defaults = Options{};
+  RejectUnknownKeys(given, defaults, context);
+  Json merged = defaults;
+  merged.merge_patch(given);
+  Options options = merged.get<Options>();
+  options.Check();
+  return options;
+}
+
+// Applies command-line assignments to options and re-validates.
+template <typename Options>
+Options WithAssignments(const Options& options, const std::vector<std::string>& assignments) {
+  Json config = options;
+  for (const std::string& assignment : assignments) ApplyAssignment(config, assignment);
+  Options result = config.get<Options>();
+  result.Check();
+  return result;
+}
+
+// Throws Error(context + ": " + what) unless `condition` holds. Used by Check() methods.
+inline void CheckOption(bool condition, const std::string& context, const std::string& what) {
+  if (!condition) throw Error(context + ": " + what);
+}
+
+}  // namespace nrslam

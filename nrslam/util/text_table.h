@@ -1,0 +1,25 @@
+// util: fixed-width text tables for the programs' result summaries.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace nrslam {
+
+class TextTable {
+ public:
+  explicit TextTable(std::vector<std::string> header) : header_(std::move(header)) {}
+  void AddRow(std::vector<std::string> row) { rows_.push_back(std::move(row)); }
+  // Columns right-aligned except the first; a rule under the header.
+  void Print(std::ostream& out) const;
+
+ private:
+  std::vector<std::string> header_;
+  std::vector<std::vector<std::string>> rows_;
+};
+
+// Fixed-point text of a number: FormatFixed(3.14159, 2) == "3.14".
+std::string FormatFixed(double value, int decimals);
+
+}  // namespace nrslam

@@ -1,0 +1,45 @@
+#include <gtest/gtest.h>
+
+#include "nrslam/sim/sim_options.h"
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+namespace {
+
+TEST(JsonOptions, AssignmentsParseWithTheFieldsType) {
+  const SimOptions options = WithAssignments(SimOptions{}, {"deformation.amplitude_mm=7.5", "frames=33",
+                                                           "camera.fov_deg=75", "camera.model=fisheye"});
+  EXPECT_DOUBLE_EQ(options.deformation.amplitude_mm, 7.5);
+  EXPECT_EQ(options.frames, 33);
+  EXPECT_EQ(options.camera.model, "fisheye");
+  EXPECT_DOUBLE_EQ(options.camera.fov_deg, 75.0);
+}
+
+TEST(JsonOptions, UnknownOptionIsAnErrorThatListsTheKnownOnes) {
+  try {
+    WithAssignments(SimOptions{}, {"deformation.amplitud_mm=5"});
+    FAIL() << "a misspelt option was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown option 'deformation.amplitud_mm'"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("deformation.amplitude_mm"), std::string::npos);
+  }
+}
+
+TEST(JsonOptions, BadValuesAndInvalidResultsAreRejected) {
+  EXPECT_THROW(WithAssignments(SimOptions{}, {"frames=many"}), Error);
+  EXPECT_THROW(WithAssignments(SimOptions{}, {"frames"}), Error);
+  EXPECT_THROW(WithAssignments(SimOptions{}, {"deformation=3"}), Error);          // a group
+  EXPECT_THROW(WithAssignments(SimOptions{}, {"camera.model=orthographic"}), Error);  // fails Check()
+  EXPECT_THROW(OptionsFromJson<SimOptions>(Json{{"sceen", "colon"}}, "test"), Error);
+}
+
+TEST(JsonOptions, RoundTripKeepsEveryField) {
+  SimOptions options = SimPreset("sim-5");
+  options.colon.fold_width_mm = 1.7;
+  options.appearance.noise_sigma = 3.5;
+  const SimOptions back = OptionsFromJson<SimOptions>(Json(options), "test");
+  EXPECT_EQ(Json(back), Json(options));
+}
+
+}  // namespace
+}  // namespace nrslam

@@ -1,0 +1,170 @@
+// The reader must reject each kind of broken sequence with a message that names the problem.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/io/sequence_writer.h"
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace {
+namespace fs = std::filesystem;
+
+constexpr int kFrames = 40;
+
+class SequenceReaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = fs::temp_directory_path() / ("nrslam_reader_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(folder_);
+    info_.camera = Camera::Pinhole(40, 30, 30, 30, 19.5, 14.5);
+    info_.frame_count = kFrames;
+    SequenceWriter writer(folder_, info_, true);
+    std::vector<StampedPose> poses;
+    for (int i = 0; i < kFrames; ++i) {
+      writer.WriteRgb(i, cv::Mat(30, 40, CV_8UC3, cv::Scalar(i, 2 * i, 3 * i)));
+      writer.WriteDepthMm(i, cv::Mat(30, 40, CV_32F, cv::Scalar(50.0 + i)));
+      poses.push_back({i / info_.fps, Rigid3()});
+    }
+    writer.WriteGroundtruth(poses);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  std::string ErrorOf() {
+    try {
+      SequenceReader reader(folder_);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  }
+  void RewriteJson(const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json json = info_;
+    edit(json);
+    std::ofstream(folder_ / "sequence.json") << json.dump();
+  }
+
+  fs::path folder_;
+  SequenceInfo info_;
+};
+
+#define EXPECT_ERROR_MENTIONS(text) EXPECT_NE(ErrorOf().find(text), std::string::npos) << "got: " << ErrorOf()
+
+TEST_F(SequenceReaderTest, ValidSequenceReadsBack) {
+  SequenceReader reader(folder_);
+  EXPECT_EQ(reader.frame_count(), kFrames);
+  EXPECT_TRUE(reader.has_depth());
+  EXPECT_TRUE(reader.has_groundtruth());
+  EXPECT_EQ(reader.ReadRgb(7).at<cv::Vec3b>(3, 3), cv::Vec3b(7, 14, 21));
+  EXPECT_NEAR(reader.ReadDepthMm(7).at<float>(3, 3), 57.0f, 1e-3);
+  EXPECT_THROW(reader.ReadRgb(kFrames), Error);
+}
+
+TEST_F(SequenceReaderTest, MissingFrameIsNamed) {
+  fs::remove(folder_ / "rgb" / "000037.png");
+  EXPECT_ERROR_MENTIONS("missing frame 37 in rgb/");
+}
+
+TEST_F(SequenceReaderTest, MissingRunOfFramesIsOneLine) {
+  for (int i = 10; i < 20; ++i) fs::remove(folder_ / "depth" / FrameFileName(i));
+  EXPECT_ERROR_MENTIONS("missing frames 10-19 in depth/");
+}
+
+TEST_F(SequenceReaderTest, DepthSizeMismatch) {
+  cv::imwrite((folder_ / "depth" / "000012.png").string(), cv::Mat(15, 20, CV_16UC1, cv::Scalar(100)));
+  EXPECT_ERROR_MENTIONS("depth/000012.png is 20x15 but the camera is 40x30 (size mismatch)");
+}
+
+TEST_F(SequenceReaderTest, DepthMustBe16Bit) {
+  cv::imwrite((folder_ / "depth" / "000003.png").string(), cv::Mat(30, 40, CV_8UC1, cv::Scalar(100)));
+  EXPECT_ERROR_MENTIONS("depth/000003.png must be 16-bit single-channel");
+}
+
+TEST_F(SequenceReaderTest, CorruptImage) {
+  std::ofstream(folder_ / "rgb" / "000005.png") << "not a png at all";
+  EXPECT_ERROR_MENTIONS("rgb/000005.png is not a readable PNG");
+}
+
+TEST_F(SequenceReaderTest, UnknownCameraModel) {
+  RewriteJson([](nlohmann::json& j) { j["camera"]["model"] = "orthographic"; });
+  EXPECT_ERROR_MENTIONS("unknown camera model 'orthographic'");
+}
+
+TEST_F(SequenceReaderTest, NegativeFocalLength) {
+  RewriteJson([](nlohmann::json& j) { j["camera"]["fx"] = -30.0; });
+  EXPECT_ERROR_MENTIONS("negative or zero focal length");
+}
+
+TEST_F(SequenceReaderTest, EmptySequence) {
+  RewriteJson([](nlohmann::json& j) { j["frame_count"] = 0; });
+  EXPECT_ERROR_MENTIONS("the sequence is empty");
+}
+
+TEST_F(SequenceReaderTest, MalformedJson) {
+  std::ofstream(folder_ / "sequence.json") << "{\"camera\": ";
+  EXPECT_ERROR_MENTIONS("sequence.json is not valid JSON");
+}
+
+TEST_F(SequenceReaderTest, MissingField) {
+  RewriteJson([](nlohmann::json& j) { j.erase("fps"); });
+  EXPECT_ERROR_MENTIONS("missing field 'fps'");
+}
+
+TEST_F(SequenceReaderTest, MissingFolderAndJson) {
+  fs::remove(folder_ / "sequence.json");
+  EXPECT_ERROR_MENTIONS("missing sequence.json");
+  EXPECT_THROW(SequenceReader(folder_ / "nowhere"), Error);
+}
+
+TEST_F(SequenceReaderTest, GroundtruthLineCount) {
+  std::ofstream(folder_ / "groundtruth.tum") << "0 0 0 0 0 0 0 1\n";
+  EXPECT_ERROR_MENTIONS("groundtruth.tum has 1 poses, expected 40");
+}
+
+TEST_F(SequenceReaderTest, GroundtruthNaN) {
+  std::ofstream(folder_ / "groundtruth.tum") << "0 nan 0 0 0 0 0 1\n";
+  EXPECT_ERROR_MENTIONS("groundtruth.tum:1");
+}
+
+TEST_F(SequenceReaderTest, StereoWithoutRightImages) {
+  RewriteJson([](nlohmann::json& j) { j["stereo"] = {{"baseline_mm", 5.0}}; });
+  EXPECT_ERROR_MENTIONS("declares stereo but right/ is missing");
+}
+
+TEST_F(SequenceReaderTest, MaskNamedButMissing) {
+  RewriteJson([](nlohmann::json& j) { j["mask"] = "mask.png"; });
+  EXPECT_ERROR_MENTIONS("mask mask.png named by sequence.json is missing");
+}
+
+TEST_F(SequenceReaderTest, ReportsEveryProblemAtOnce) {
+  fs::remove(folder_ / "rgb" / "000037.png");
+  cv::imwrite((folder_ / "depth" / "000012.png").string(), cv::Mat(15, 20, CV_16UC1, cv::Scalar(100)));
+  const std::string error = ErrorOf();
+  EXPECT_NE(error.find("missing frame 37"), std::string::npos);
+  EXPECT_NE(error.find("000012.png"), std::string::npos);
+}
+
+TEST_F(SequenceReaderTest, FixedAndPerFrameMasksCombine) {
+  cv::Mat fixed(30, 40, CV_8UC1, cv::Scalar(255));
+  fixed.colRange(0, 5) = 0;
+  cv::imwrite((folder_ / "mask.png").string(), fixed);
+  fs::create_directories(folder_ / "masks");
+  for (int i = 0; i < kFrames; ++i) {
+    cv::Mat frame_mask(30, 40, CV_8UC1, cv::Scalar(255));
+    frame_mask.rowRange(0, 2) = 0;
+    cv::imwrite((folder_ / "masks" / FrameFileName(i)).string(), frame_mask);
+  }
+  RewriteJson([](nlohmann::json& j) { j["mask"] = "mask.png"; });
+  SequenceReader reader(folder_);
+  const cv::Mat mask = reader.ReadMask(3);
+  EXPECT_EQ(mask.at<uint8_t>(10, 2), 0);   // fixed mask
+  EXPECT_EQ(mask.at<uint8_t>(1, 20), 0);   // frame mask
+  EXPECT_EQ(mask.at<uint8_t>(10, 20), 255);
+}
+
+}  // namespace
+}  // namespace nrslam
