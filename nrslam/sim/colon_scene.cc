@@ -121,10 +121,14 @@ SurfaceGrid ColonScene::Grid(int, double time_s) const {
   const double arc = CameraArc(time_s);
   SurfaceGrid grid;
   grid.periodic_v = true;
-  // Rings are finest at the camera and coarsen ahead (2 % per mm), where a pixel covers more surface.
-  const double begin = std::max(0.0, arc - 12.0), end = std::min(length_mm_, arc + colon.view_ahead_mm);
-  for (double s = begin; s < end; s += colon.ring_spacing_mm * (1.0 + 0.02 * std::abs(s - arc))) grid.u.push_back(s);
-  grid.u.push_back(end);
+  // Rings sit at fixed offsets from the camera, finest at the camera and coarsening ahead
+  // (2 % per mm): the mesh keeps its topology from frame to frame, so the ray caster can
+  // refit its BVH instead of rebuilding it. The tube exists for s < 0 too; only its texture
+  // clamps there.
+  for (double offset = -12.0; offset < colon.view_ahead_mm; offset += colon.ring_spacing_mm * (1.0 + 0.02 * std::abs(offset))) {
+    grid.u.push_back(arc + offset);
+  }
+  grid.u.push_back(arc + colon.view_ahead_mm);
   grid.v.resize(colon.angular_steps);
   for (int j = 0; j < colon.angular_steps; ++j) grid.v[j] = kTwoPi * j / colon.angular_steps;
   return grid;

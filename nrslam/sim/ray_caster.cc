@@ -69,30 +69,51 @@ void RayCaster::Tessellate(const Scene& scene, int patch, double time_s, PatchMe
 
 void RayCaster::Build(const Scene& scene, double time_s, const Eigen::Vector3d& origin) {
   origin_ = origin;
-  meshes_.resize(scene.patch_count());
-  if (rtc_scene_) rtcReleaseScene(rtc_scene_);
-  rtc_scene_ = rtcNewScene(device_);
-  rtcSetSceneFlags(rtc_scene_, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_LOW);  // rebuilt every frame
-  for (int patch = 0; patch < scene.patch_count(); ++patch) {
-    PatchMesh& mesh = meshes_[patch];
-    Tessellate(scene, patch, time_s, &mesh);
-    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                 3 * sizeof(float), mesh.vertices.size()));
-    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                   3 * sizeof(uint32_t), mesh.triangles.size()));
-    if (!vertices || !indices) throw Error("Embree: out of memory for the scene mesh");
-    for (size_t k = 0; k < mesh.vertices.size(); ++k) {
+  const size_t patches = static_cast<size_t>(scene.patch_count());
+  std::vector<size_t> previous_sizes;
+  for (const PatchMesh& mesh : meshes_) previous_sizes.push_back(mesh.vertices.size());
+  meshes_.resize(patches);
+  for (size_t patch = 0; patch < patches; ++patch) Tessellate(scene, static_cast<int>(patch), time_s, &meshes_[patch]);
+
+  bool refit = rtc_scene_ && previous_sizes.size() == patches && ++builds_since_rebuild_ < kRebuildPeriod;
+  for (size_t patch = 0; refit && patch < patches; ++patch) refit = previous_sizes[patch] == meshes_[patch].vertices.size();
+  if (!refit) {
+    if (rtc_scene_) rtcReleaseScene(rtc_scene_);
+    rtc_scene_ = rtcNewScene(device_);
+    rtcSetSceneFlags(rtc_scene_, static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC));
+    rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_LOW);  // SAH builds cost more than they save here
+    geometries_.assign(patches, nullptr);
+    builds_since_rebuild_ = 0;
+  }
+  for (size_t patch = 0; patch < patches; ++patch) {
+    const PatchMesh& mesh = meshes_[patch];
+    RTCGeometry geometry = geometries_[patch];
+    if (!refit) {
+      geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                              mesh.vertices.size());
+      auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+          geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), mesh.triangles.size()));
+      if (!indices) throw Error("Embree: out of memory for the scene mesh");
+      for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+        for (int c = 0; c < 3; ++c) indices[3 * k + c] = mesh.triangles[k][c];
+      }
+      rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
+    }
+    auto* vertices = static_cast<float*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_VERTEX, 0));
+    if (!vertices) throw Error("Embree: out of memory for the scene mesh");
+    const long vertex_count = static_cast<long>(mesh.vertices.size());
+#pragma omp parallel for schedule(static) num_threads(threads_ > 0 ? threads_ : omp_get_max_threads())
+    for (long k = 0; k < vertex_count; ++k) {
       for (int c = 0; c < 3; ++c) vertices[3 * k + c] = static_cast<float>(mesh.vertices[k][c]);
     }
-    for (size_t k = 0; k < mesh.triangles.size(); ++k) {
-      for (int c = 0; c < 3; ++c) indices[3 * k + c] = mesh.triangles[k][c];
-    }
-    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_LOW);
+    if (refit) rtcUpdateGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0);
     rtcCommitGeometry(geometry);
-    rtcAttachGeometryByID(rtc_scene_, geometry, static_cast<unsigned>(patch));
-    rtcReleaseGeometry(geometry);
+    if (!refit) {
+      rtcAttachGeometryByID(rtc_scene_, geometry, static_cast<unsigned>(patch));
+      rtcReleaseGeometry(geometry);  // the scene keeps it alive
+      geometries_[patch] = geometry;
+    }
   }
   rtcCommitScene(rtc_scene_);
 }
@@ -116,12 +137,48 @@ SurfaceHit RayCaster::Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d&
   ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(rtc_scene_, &context, &ray_hit);
-  SurfaceHit hit;
-  if (ray_hit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  if (ray_hit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return SurfaceHit();
+  return Refine(ray_hit.hit.geomID, ray_hit.hit.primID, origin, unit_direction);
+}
 
+void RayCaster::Cast8(const Eigen::Vector3d& origin, const Eigen::Vector3d* unit_directions, const bool* active,
+                      SurfaceHit* hits) const {
+  const Eigen::Vector3d local_origin = origin - origin_;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(32) RTCRayHit8 packet;
+  alignas(32) int valid[kPacket];
+  for (int i = 0; i < kPacket; ++i) {
+    valid[i] = active[i] ? -1 : 0;
+    packet.ray.org_x[i] = static_cast<float>(local_origin.x());
+    packet.ray.org_y[i] = static_cast<float>(local_origin.y());
+    packet.ray.org_z[i] = static_cast<float>(local_origin.z());
+    packet.ray.dir_x[i] = static_cast<float>(unit_directions[i].x());
+    packet.ray.dir_y[i] = static_cast<float>(unit_directions[i].y());
+    packet.ray.dir_z[i] = static_cast<float>(unit_directions[i].z());
+    packet.ray.tnear[i] = 0.f;
+    packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
+    packet.ray.mask[i] = 0xffffffffu;
+    packet.ray.flags[i] = 0;
+    packet.ray.time[i] = 0.f;
+    packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect8(valid, rtc_scene_, &context, &packet);
+  for (int i = 0; i < kPacket; ++i) {
+    hits[i] = active[i] && packet.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID
+                  ? Refine(packet.hit.geomID[i], packet.hit.primID[i], origin, unit_directions[i])
+                  : SurfaceHit();
+  }
+}
+
+SurfaceHit RayCaster::Refine(unsigned patch, unsigned triangle_index, const Eigen::Vector3d& origin,
+                             const Eigen::Vector3d& unit_direction) const {
+  SurfaceHit hit;
+  const Eigen::Vector3d local_origin = origin - origin_;
   // Exact intersection with the hit triangle, in double (Möller–Trumbore).
-  const PatchMesh& mesh = meshes_[ray_hit.hit.geomID];
-  const auto& triangle = mesh.triangles[ray_hit.hit.primID];
+  const PatchMesh& mesh = meshes_[patch];
+  const auto& triangle = mesh.triangles[triangle_index];
   const Eigen::Vector3d& p0 = mesh.vertices[triangle[0]];
   const Eigen::Vector3d e1 = mesh.vertices[triangle[1]] - p0, e2 = mesh.vertices[triangle[2]] - p0;
   const Eigen::Vector3d pvec = unit_direction.cross(e2);
@@ -133,7 +190,7 @@ SurfaceHit RayCaster::Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d&
   const double b2 = unit_direction.dot(qvec) / det;
   const double b0 = 1.0 - b1 - b2;
   hit.valid = true;
-  hit.patch = static_cast<int>(ray_hit.hit.geomID);
+  hit.patch = static_cast<int>(patch);
   hit.distance = e2.dot(qvec) / det;
   hit.position = origin + hit.distance * unit_direction;
   hit.normal = (b0 * mesh.normals[triangle[0]].cast<double>() + b1 * mesh.normals[triangle[1]].cast<double>() +

@@ -35,9 +35,17 @@ class RayCaster {
   RayCaster& operator=(const RayCaster&) = delete;
 
   // Tessellates `scene` at `time_s`; rays will be cast from near `origin` (world, mm).
+  // When the tessellation keeps its topology the BVH is refitted, and rebuilt from scratch
+  // every kRebuildPeriod builds so its quality cannot drift.
+  static constexpr int kRebuildPeriod = 30;
   void Build(const Scene& scene, double time_s, const Eigen::Vector3d& origin);
   // Thread-safe once built.
   SurfaceHit Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& unit_direction) const;
+  // Eight rays from one origin at once (Embree ray packets: neighbouring pixels share most
+  // of their traversal). Lanes with active[i] == false are skipped and left invalid.
+  static constexpr int kPacket = 8;
+  void Cast8(const Eigen::Vector3d& origin, const Eigen::Vector3d* unit_directions, const bool* active,
+             SurfaceHit* hits) const;
   size_t triangle_count() const;
 
  private:
@@ -50,11 +58,16 @@ class RayCaster {
   };
   RTCDevice device_ = nullptr;
   RTCScene rtc_scene_ = nullptr;
+  std::vector<RTCGeometry> geometries_;  // one per patch, owned by rtc_scene_
+  int builds_since_rebuild_ = 0;
   std::vector<PatchMesh> meshes_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   int threads_;
 
   void Tessellate(const Scene& scene, int patch, double time_s, PatchMesh* mesh) const;
+  // The exact hit of a ray on a triangle Embree reported.
+  SurfaceHit Refine(unsigned patch, unsigned triangle_index, const Eigen::Vector3d& origin,
+                    const Eigen::Vector3d& unit_direction) const;
 };
 
 }  // namespace nrslam

@@ -55,7 +55,10 @@ class Renderer {
   std::vector<Eigen::Vector3d> bearings_;  // per pixel, camera frame
   std::vector<float> vignetting_;          // per pixel gain; 0 outside the image circle
   cv::Mat validity_mask_;
+  std::vector<float> display_levels_;      // linear radiance → 8-bit level through the gamma curve
   int threads_;
+
+  double DisplayLevel(double radiance) const;
 
   RenderedView RenderView(const Rigid3& world_from_camera, int frame_index, int view);
 };

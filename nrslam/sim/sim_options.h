@@ -54,8 +54,8 @@ struct ColonOptions {
   double wobble_lateral_mm = 1.5;       // smooth lateral wobble of the tip, mm
   double wobble_rotation_deg = 3.0;     // smooth rotational wobble of the tip, deg
   double view_ahead_mm = 220.0;         // colon length meshed ahead of the camera, mm
-  double ring_spacing_mm = 0.3;         // mesh ring spacing at the camera, grows 2 % per mm ahead
-  int angular_steps = 480;              // mesh vertices around the lumen
+  double ring_spacing_mm = 0.4;         // mesh ring spacing at the camera, grows 2 % per mm ahead
+  int angular_steps = 400;              // mesh vertices around the lumen
   bool straight = false;                // straight cylinder of radius_mean_mm, no folds (tests)
   void Check() const;
 };
