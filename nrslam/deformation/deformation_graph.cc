@@ -1,0 +1,118 @@
+#include "nrslam/deformation/deformation_graph.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+
+DeformationGraph::DeformationGraph(const DeformationModelOptions& options, double sigma) : options_(options) {
+  options_.Check();
+  set_sigma(sigma);
+}
+
+void DeformationGraph::set_sigma(double sigma) {
+  if (!(sigma > 0) || !std::isfinite(sigma)) throw Error("deformation graph: sigma must be > 0");
+  sigma_ = sigma;
+  for (GraphEdge& edge : edges_) edge.weight = WeightOf(edge.max_length);
+}
+
+double DeformationGraph::WeightOf(double max_length) const {
+  return std::exp(-max_length * max_length / (2.0 * sigma_ * sigma_));
+}
+
+uint64_t DeformationGraph::PairKey(PointId a, PointId b) {
+  const auto low = static_cast<uint64_t>(std::min(a, b)), high = static_cast<uint64_t>(std::max(a, b));
+  return (high << 32) ^ low ^ (high >> 32);
+}
+
+std::optional<int> DeformationGraph::FindEdge(PointId a, PointId b) const {
+  const auto candidates = edge_index_.find(PairKey(a, b));
+  if (candidates == edge_index_.end()) return std::nullopt;
+  const GraphEdge& edge = edges_[candidates->second];
+  if ((edge.a == a && edge.b == b) || (edge.a == b && edge.b == a)) return candidates->second;
+  // A key collision (only possible for ids beyond 2³²): fall back to the adjacency list.
+  const auto list = adjacency_.find(a);
+  if (list == adjacency_.end()) return std::nullopt;
+  for (int index : list->second) {
+    if (edges_[index].a == b || edges_[index].b == b) return index;
+  }
+  return std::nullopt;
+}
+
+void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
+  if (a == b || FindEdge(a, b)) return;
+  if (!(length > 0) || !std::isfinite(length)) return;  // coincident or invalid points: no direction to regularise
+  const int index = static_cast<int>(edges_.size());
+  edges_.push_back({a, b, length, length, length, WeightOf(length), false});
+  adjacency_[a].push_back(index);
+  adjacency_[b].push_back(index);
+  edge_index_.emplace(PairKey(a, b), index);
+}
+
+void DeformationGraph::ConnectCovisible(const std::vector<PointId>& new_points, const std::vector<PointId>& existing,
+                                        const PositionLookup& position) {
+  std::vector<std::pair<PointId, Eigen::Vector3d>> located;
+  for (PointId id : new_points) {
+    if (const auto p = position(id)) located.emplace_back(id, *p);
+  }
+  const size_t new_count = located.size();
+  for (PointId id : existing) {
+    if (const auto p = position(id)) located.emplace_back(id, *p);
+  }
+  for (size_t i = 0; i < new_count; ++i) {
+    for (size_t j = i + 1; j < located.size(); ++j) {
+      AddEdge(located[i].first, located[j].first, (located[i].second - located[j].second).norm());
+    }
+  }
+}
+
+void DeformationGraph::UpdatePoint(PointId point, const PositionLookup& position) {
+  const auto list = adjacency_.find(point);
+  if (list == adjacency_.end()) return;
+  const auto here = position(point);
+  if (!here) return;
+  for (int index : list->second) {
+    GraphEdge& edge = edges_[index];
+    const auto there = position(edge.a == point ? edge.b : edge.a);
+    if (!there) continue;
+    const double length = (*here - *there).norm();
+    edge.min_length = std::min(edge.min_length, length);
+    edge.max_length = std::max(edge.max_length, length);
+    edge.weight = WeightOf(edge.max_length);
+    if ((edge.max_length - edge.min_length) / edge.min_length > options_.stretch_threshold) edge.pruned = true;
+  }
+}
+
+std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point) const {
+  std::vector<GraphNeighbour> neighbours;
+  const auto list = adjacency_.find(point);
+  if (list == adjacency_.end()) return neighbours;
+  for (int index : list->second) {
+    const GraphEdge& edge = edges_[index];
+    if (edge.pruned || edge.weight < options_.min_edge_weight) continue;
+    neighbours.push_back({edge.a == point ? edge.b : edge.a, index, edge.weight});
+  }
+  const size_t keep = std::min(neighbours.size(), static_cast<size_t>(options_.max_degree_D));
+  // Ties broken by id so the choice never depends on insertion order.
+  std::partial_sort(neighbours.begin(), neighbours.begin() + keep, neighbours.end(),
+                    [](const GraphNeighbour& x, const GraphNeighbour& y) {
+                      return x.weight != y.weight ? x.weight > y.weight : x.id < y.id;
+                    });
+  neighbours.resize(keep);
+  return neighbours;
+}
+
+int DeformationGraph::GoodEdgeCount(PointId point) const {
+  const auto list = adjacency_.find(point);
+  if (list == adjacency_.end()) return 0;
+  return static_cast<int>(std::count_if(list->second.begin(), list->second.end(),
+                                        [&](int index) { return !edges_[index].pruned; }));
+}
+
+size_t DeformationGraph::pruned_count() const {
+  return static_cast<size_t>(std::count_if(edges_.begin(), edges_.end(), [](const GraphEdge& e) { return e.pruned; }));
+}
+
+}  // namespace nrslam

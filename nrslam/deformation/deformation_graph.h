@@ -1,0 +1,83 @@
+// deformation: the Dynamic Deformation Graph (DDG).
+//
+// Nodes are map points; an edge joins two points that were seen together when one of them
+// was created. Each edge keeps its rest length d0 (its length at creation, what the spring
+// pulls towards), the shortest and longest lengths ever observed, d_min and d_max, and its
+// weight b = exp(−d_max² / 2σ²). An edge is pruned — for good, since d_max only grows and
+// d_min only shrinks — once (d_max − d_min)/d_min exceeds the stretching threshold: the two
+// points no longer deform together. Each point is regularised by its best D unpruned edges.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "nrslam/deformation/deformation_options.h"
+
+namespace nrslam {
+
+using PointId = int64_t;
+
+struct GraphEdge {
+  PointId a = -1, b = -1;
+  double rest_length = 0.0;  // d0
+  double min_length = 0.0;   // d_min
+  double max_length = 0.0;   // d_max
+  double weight = 0.0;       // b = exp(−d_max²/2σ²)
+  bool pruned = false;
+};
+
+struct GraphNeighbour {
+  PointId id;
+  int edge;       // index into DeformationGraph::edge()
+  double weight;  // b of that edge
+};
+
+// Current position of a point, or nullopt if it has none now.
+using PositionLookup = std::function<std::optional<Eigen::Vector3d>(PointId)>;
+
+class DeformationGraph {
+ public:
+  explicit DeformationGraph(const DeformationModelOptions& options, double sigma = 1.0);
+
+  double sigma() const { return sigma_; }
+  // Sets σ (map units) and recomputes every weight.
+  void set_sigma(double sigma);
+
+  // Adds the edge a–b with the given current length; no-op if it exists or a == b.
+  void AddEdge(PointId a, PointId b, double length);
+  // Joins each new point to every other new point and to every existing point that has a
+  // position: the points co-visible at creation.
+  void ConnectCovisible(const std::vector<PointId>& new_points, const std::vector<PointId>& existing,
+                        const PositionLookup& position);
+  // Re-measures the point's edges from current positions: d_min, d_max, b, pruning.
+  // Neighbours without a position keep their edge untouched.
+  void UpdatePoint(PointId point, const PositionLookup& position);
+
+  // Up to max_degree_D unpruned edges with b >= min_edge_weight, highest b first.
+  std::vector<GraphNeighbour> BestNeighbours(PointId point) const;
+  int GoodEdgeCount(PointId point) const;
+  // Fewer than min_good_edges unpruned edges left: the point's deformation is unconstrained.
+  bool IsWeaklyConnected(PointId point) const { return GoodEdgeCount(point) < options_.min_good_edges; }
+
+  const GraphEdge& edge(int index) const { return edges_[index]; }
+  size_t edge_count() const { return edges_.size(); }
+  size_t pruned_count() const;
+  std::optional<int> FindEdge(PointId a, PointId b) const;
+
+ private:
+  DeformationModelOptions options_;
+  double sigma_;
+  std::vector<GraphEdge> edges_;
+  std::unordered_map<PointId, std::vector<int>> adjacency_;
+  std::unordered_map<uint64_t, int> edge_index_;  // keyed by the unordered pair
+
+  double WeightOf(double max_length) const;
+  static uint64_t PairKey(PointId a, PointId b);
+};
+
+}  // namespace nrslam

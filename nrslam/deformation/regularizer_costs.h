@@ -1,0 +1,83 @@
+// deformation: the elastic (spring) and viscous (damper) regularisers as Ceres functors.
+//
+// Both residuals are linear in what they penalise, times a multiplier that carries the
+// weighting (deformation_options.h), so that the squared residual is the energy:
+//   elastic  r = c_e · (d − d0),  d = ‖x_i − x_j‖;
+//     paper:     c_e = √(k/d0)          → r² = k (d − d0)²/d0
+//     reference: c_e = k / (d0 · σ_e)   → r² = k² (d − d0)²/(d0² σ_e²)
+//   viscous  r = c_v · (δ_i − δ_j);
+//     paper:     c_v = √b               → r² = b ‖δ_i − δ_j‖²
+//     reference: c_v = b / (σ_v · s)    → r² = b² ‖δ_i − δ_j‖²/(σ_v s)²   (s = map scale)
+#pragma once
+
+#include <ceres/autodiff_cost_function.h>
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "nrslam/deformation/deformation_options.h"
+
+namespace nrslam {
+
+double ElasticMultiplier(const DeformationModelOptions& options, double rest_length);
+double ViscousMultiplier(const DeformationModelOptions& options, double edge_weight_b, double map_scale);
+
+// Spring between two points whose positions are base + parameter: in tracking the bases are
+// the previous positions and the parameters the displacements δ; in DBA the bases are zero
+// and the parameters a keyframe's positions x^k.
+struct ElasticCost {
+  Eigen::Vector3d base_i, base_j;
+  double rest_length;  // d0, map units
+  double multiplier;   // c_e
+
+  template <typename T>
+  bool operator()(const T* p_i, const T* p_j, T* residual) const {
+    T squared(0);
+    for (int a = 0; a < 3; ++a) {
+      const T difference = (T(base_i[a]) + p_i[a]) - (T(base_j[a]) + p_j[a]);
+      squared += difference * difference;
+    }
+    using std::sqrt;
+    // The epsilon keeps the derivative finite for coincident points (never met in practice).
+    residual[0] = T(multiplier) * (sqrt(squared + T(1e-24)) - T(rest_length));
+    return true;
+  }
+  static ceres::CostFunction* Create(const Eigen::Vector3d& base_i, const Eigen::Vector3d& base_j,
+                                     double rest_length, double multiplier) {
+    return new ceres::AutoDiffCostFunction<ElasticCost, 1, 3, 3>(
+        new ElasticCost{base_i, base_j, rest_length, multiplier});
+  }
+};
+
+// Damper on the difference of two points' motions over one frame (tracking): δ_i − δ_j.
+struct ViscousCost {
+  double multiplier;  // c_v
+
+  template <typename T>
+  bool operator()(const T* delta_i, const T* delta_j, T* residual) const {
+    for (int a = 0; a < 3; ++a) residual[a] = T(multiplier) * (delta_i[a] - delta_j[a]);
+    return true;
+  }
+  static ceres::CostFunction* Create(double multiplier) {
+    return new ceres::AutoDiffCostFunction<ViscousCost, 3, 3, 3>(new ViscousCost{multiplier});
+  }
+};
+
+// The same damper between consecutive keyframes k, k+1 of the DBA window, where the motions
+// are differences of per-keyframe positions: (x_i^{k+1} − x_i^k) − (x_j^{k+1} − x_j^k).
+struct ViscousKeyframeCost {
+  double multiplier;
+
+  template <typename T>
+  bool operator()(const T* x_i_k, const T* x_i_next, const T* x_j_k, const T* x_j_next, T* residual) const {
+    for (int a = 0; a < 3; ++a) {
+      residual[a] = T(multiplier) * ((x_i_next[a] - x_i_k[a]) - (x_j_next[a] - x_j_k[a]));
+    }
+    return true;
+  }
+  static ceres::CostFunction* Create(double multiplier) {
+    return new ceres::AutoDiffCostFunction<ViscousKeyframeCost, 3, 3, 3, 3, 3>(new ViscousKeyframeCost{multiplier});
+  }
+};
+
+}  // namespace nrslam

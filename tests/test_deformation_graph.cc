@@ -1,0 +1,139 @@
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "nrslam/deformation/deformation_graph.h"
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace {
+
+struct Positions {
+  std::map<PointId, Eigen::Vector3d> at;
+  PositionLookup Lookup() const {
+    return [this](PointId id) -> std::optional<Eigen::Vector3d> {
+      const auto found = at.find(id);
+      if (found == at.end()) return std::nullopt;
+      return found->second;
+    };
+  }
+  std::vector<PointId> Ids() const {
+    std::vector<PointId> ids;
+    for (const auto& entry : at) ids.push_back(entry.first);
+    return ids;
+  }
+};
+
+TEST(DeformationGraph, CreationJoinsCovisiblePointsWithTheirLengthsAndWeights) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 2.0);
+  Positions positions;
+  positions.at = {{1, {0, 0, 0}}, {2, {1, 0, 0}}, {3, {0, 2, 0}}};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  EXPECT_EQ(graph.edge_count(), 3u);
+  const GraphEdge& edge = graph.edge(*graph.FindEdge(3, 1));
+  EXPECT_DOUBLE_EQ(edge.rest_length, 2.0);
+  EXPECT_DOUBLE_EQ(edge.weight, std::exp(-4.0 / 8.0));
+  // A new point joins every existing point, not only its nearest.
+  positions.at[4] = {5, 5, 0};
+  graph.ConnectCovisible({4}, {1, 2, 3, 99}, positions.Lookup());  // 99 has no position: skipped
+  EXPECT_EQ(graph.edge_count(), 6u);
+  EXPECT_FALSE(graph.FindEdge(4, 99));
+  // Adding an existing edge again changes nothing.
+  graph.AddEdge(2, 1, 7.0);
+  EXPECT_EQ(graph.edge_count(), 6u);
+  EXPECT_DOUBLE_EQ(graph.edge(*graph.FindEdge(1, 2)).rest_length, 1.0);
+}
+
+TEST(DeformationGraph, EachPointUsesItsBestDEdgesByWeight) {
+  DeformationModelOptions options;
+  options.max_degree_D = 3;
+  DeformationGraph graph(options, 4.0);
+  Positions positions;
+  positions.at[0] = {0, 0, 0};
+  for (int i = 1; i <= 12; ++i) positions.at[i] = {0.5 * i, 0, 0};  // farther and farther
+  graph.ConnectCovisible({0}, positions.Ids(), positions.Lookup());
+  const auto best = graph.BestNeighbours(0);
+  ASSERT_EQ(best.size(), 3u);
+  EXPECT_EQ(best[0].id, 1);
+  EXPECT_EQ(best[1].id, 2);
+  EXPECT_EQ(best[2].id, 3);
+  EXPECT_GT(best[0].weight, best[1].weight);
+  // Edges with b below min_edge_weight (d_max > 1.5σ = 6) are never used, however many slots.
+  options.max_degree_D = 100;
+  DeformationGraph wide(options, 4.0);
+  wide.ConnectCovisible({0}, positions.Ids(), positions.Lookup());
+  EXPECT_EQ(wide.BestNeighbours(0).size(), 12u);  // 0.5 … 6.0: all within 1.5σ
+  wide.set_sigma(2.0);                             // now only d <= 3 qualifies
+  EXPECT_EQ(wide.BestNeighbours(0).size(), 6u);
+}
+
+// Two clusters that separate (the lap-lobes situation): every edge across is pruned, none within.
+TEST(DeformationGraph, PrunesEdgesBetweenSeparatingClusters) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 10.0);
+  Positions positions;
+  for (int i = 0; i < 8; ++i) {
+    positions.at[i] = {0.3 * (i % 4), 0.3 * (i / 4), 0};       // cluster A
+    positions.at[100 + i] = {2.0 + 0.3 * (i % 4), 0.3 * (i / 4), 0};  // cluster B
+  }
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  const size_t edges = graph.edge_count();
+  EXPECT_EQ(edges, 16u * 15u / 2u);
+  for (int step = 1; step <= 30; ++step) {  // B slides away rigidly
+    for (int i = 0; i < 8; ++i) positions.at[100 + i].x() += 0.2;
+    for (const PointId id : positions.Ids()) graph.UpdatePoint(id, positions.Lookup());
+  }
+  size_t across_pruned = 0, within_pruned = 0;
+  for (size_t e = 0; e < graph.edge_count(); ++e) {
+    const GraphEdge& edge = graph.edge(static_cast<int>(e));
+    const bool across = (edge.a < 100) != (edge.b < 100);
+    (across ? across_pruned : within_pruned) += edge.pruned ? 1 : 0;
+  }
+  EXPECT_EQ(across_pruned, 64u);
+  EXPECT_EQ(within_pruned, 0u);
+  EXPECT_EQ(graph.pruned_count(), 64u);
+  for (const PointId id : positions.Ids()) {
+    EXPECT_EQ(graph.GoodEdgeCount(id), 7);
+    EXPECT_FALSE(graph.IsWeaklyConnected(id));
+    for (const auto& neighbour : graph.BestNeighbours(id)) EXPECT_EQ(neighbour.id < 100, id < 100);
+  }
+}
+
+TEST(DeformationGraph, WeightFollowsTheLongestLengthEverSeen) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 1.0);
+  Positions positions;
+  positions.at = {{1, {0, 0, 0}}, {2, {1, 0, 0}}};
+  graph.ConnectCovisible({1, 2}, {}, positions.Lookup());
+  positions.at[2] = {1.5, 0, 0};
+  graph.UpdatePoint(1, positions.Lookup());
+  positions.at[2] = {1.0, 0, 0};  // back to rest: the weight does not recover
+  graph.UpdatePoint(2, positions.Lookup());
+  const GraphEdge& edge = graph.edge(0);
+  EXPECT_DOUBLE_EQ(edge.max_length, 1.5);
+  EXPECT_DOUBLE_EQ(edge.min_length, 1.0);
+  EXPECT_DOUBLE_EQ(edge.weight, std::exp(-1.5 * 1.5 / 2.0));
+  EXPECT_FALSE(edge.pruned);  // stretch 0.5 < 1.1
+  positions.at[2] = {0.4, 0, 0};  // d_min 0.4: (1.5 − 0.4)/0.4 = 2.75 > 1.1
+  graph.UpdatePoint(2, positions.Lookup());
+  EXPECT_TRUE(graph.edge(0).pruned);
+}
+
+TEST(DeformationGraph, FlagsPointsLeftWithTooFewEdges) {
+  DeformationModelOptions options;
+  options.min_good_edges = 2;
+  DeformationGraph graph(options, 5.0);
+  Positions positions;
+  positions.at = {{1, {0, 0, 0}}, {2, {1, 0, 0}}, {3, {0, 1, 0}}};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  EXPECT_FALSE(graph.IsWeaklyConnected(1));
+  positions.at[1] = {-5, -5, 0};  // point 1 tears away from both
+  graph.UpdatePoint(1, positions.Lookup());
+  EXPECT_EQ(graph.GoodEdgeCount(1), 0);
+  EXPECT_TRUE(graph.IsWeaklyConnected(1));
+  EXPECT_THROW(graph.set_sigma(0.0), Error);
+}
+
+}  // namespace
+}  // namespace nrslam
