@@ -1,0 +1,29 @@
+#include "nrslam/frontend/frontend_options.h"
+
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+void MaskOptions::Check() const {
+  CheckOption(border_px >= 0 && bright_margin_px >= 0 && erosion_px >= 0, "masks", "sizes must be >= 0");
+  CheckOption(bright_threshold >= 0 && bright_threshold <= 255, "masks", "bright_threshold must be in [0, 255]");
+}
+
+void FeatureOptions::Check() const {
+  CheckOption(min_eigenvalue > 0, "features", "min_eigenvalue must be > 0");
+  CheckOption(nms_radius_px >= 1 && exclusion_radius_px >= 0, "features", "radii must be >= 1 / >= 0");
+  CheckOption(max_features >= 1, "features", "max_features must be >= 1");
+}
+
+void KltOptions::Check() const {
+  CheckOption(window_px >= 5 && window_px % 2 == 1 && window_px <= 63, "klt", "window_px must be odd, 5..63");
+  CheckOption(levels >= 1 && levels <= 8, "klt", "levels must be 1..8");
+  CheckOption(max_iterations >= 1 && epsilon_px > 0 && min_eigenvalue >= 0, "klt",
+              "max_iterations >= 1, epsilon_px > 0, min_eigenvalue >= 0");
+  CheckOption(max_displacement_px > 0, "klt", "max_displacement_px must be > 0");
+  for (double ssim : {ssim_tracking, ssim_initialisation, ssim_reassociation}) {
+    CheckOption(ssim >= -1 && ssim <= 1, "klt", "SSIM thresholds must be in [-1, 1]");
+  }
+}
+
+}  // namespace nrslam
