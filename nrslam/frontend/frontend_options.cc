@@ -21,6 +21,7 @@ void KltOptions::Check() const {
   CheckOption(max_iterations >= 1 && epsilon_px > 0 && min_eigenvalue >= 0, "klt",
               "max_iterations >= 1, epsilon_px > 0, min_eigenvalue >= 0");
   CheckOption(max_displacement_px > 0, "klt", "max_displacement_px must be > 0");
+  CheckOption(affine_iterations >= 1, "klt", "affine_iterations must be >= 1");
   for (double ssim : {ssim_tracking, ssim_initialisation, ssim_reassociation}) {
     CheckOption(ssim >= -1 && ssim <= 1, "klt", "SSIM thresholds must be in [-1, 1]");
   }

@@ -22,7 +22,10 @@ int CoarseOverhang(int level, int half) { return level > 0 ? std::min(half, Imag
 
 // Bilinear sample at arbitrary (x, y) of a level image (inside its border).
 inline float SampleAt(const cv::Mat& image, float x, float y) {
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  // Truncation after a shift is floor() for anything inside the pyramid's border, and cheaper.
+  constexpr int kShift = 64;
+  static_assert(kShift > ImagePyramid::border(), "the shift must cover the border");
+  const int x0 = static_cast<int>(x + kShift) - kShift, y0 = static_cast<int>(y + kShift) - kShift;
   const float ax = x - x0, ay = y - y0;
   const float* row0 = image.ptr<float>(y0) + x0;
   const float* row1 = image.ptr<float>(y0 + 1) + x0;
@@ -58,18 +61,27 @@ bool SolveSymmetric6(const double* h, const double* b, double* x) {
   return true;
 }
 
-// Bilinear sample of the side×side window centred at (x, y). All taps share the same
-// weights (a translation), so each row is a fixed blend of two image rows.
-void SampleWindow(const cv::Mat& image, float x, float y, int side, float* out) {
-  const float left = x - (side - 1) * 0.5f, top = y - (side - 1) * 0.5f;
+// The top-left tap and the four bilinear weights of a window whose top-left sample is at
+// (left, top). For a translated window all samples share them, so each row of the window is
+// a fixed blend of two image rows.
+struct BilinearTaps {
+  int x0, y0;
+  float w00, w01, w10, w11;
+};
+BilinearTaps TapsAt(float left, float top) {
   const int x0 = static_cast<int>(std::floor(left)), y0 = static_cast<int>(std::floor(top));
   const float ax = left - x0, ay = top - y0;
-  const float w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
+  return {x0, y0, (1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+}
+
+// Bilinear sample of the side×side window centred at (x, y).
+void SampleWindow(const cv::Mat& image, float x, float y, int side, float* out) {
+  const BilinearTaps t = TapsAt(x - (side - 1) * 0.5f, y - (side - 1) * 0.5f);
   for (int r = 0; r < side; ++r) {
-    const float* row0 = image.ptr<float>(y0 + r) + x0;
-    const float* row1 = image.ptr<float>(y0 + r + 1) + x0;
+    const float* row0 = image.ptr<float>(t.y0 + r) + t.x0;
+    const float* row1 = image.ptr<float>(t.y0 + r + 1) + t.x0;
     float* o = out + r * side;
-    for (int c = 0; c < side; ++c) o[c] = w00 * row0[c] + w01 * row0[c + 1] + w10 * row1[c] + w11 * row1[c + 1];
+    for (int c = 0; c < side; ++c) o[c] = t.w00 * row0[c] + t.w01 * row0[c + 1] + t.w10 * row1[c] + t.w11 * row1[c + 1];
   }
 }
 
@@ -102,68 +114,104 @@ float Ssim(const float* x, const float* y, int count) {
 // (β + β_u·u + β_v·v). The gain is the ratio of the de-trended deviations (robust even far
 // from convergence); the plane is what remains of the two windows' linear trends. Endoscope
 // light changes across a patch, not only between patches.
-KltTracker::AppearanceBasis KltTracker::MakeAppearanceBasis(const float* patch) const {
-  AppearanceBasis basis;
-  basis.area = area_;
-  basis.vectors.assign(4 * static_cast<size_t>(area_), 0.f);
-  basis.count = 0;
-  auto add = [&](std::vector<double> vector) {  // Gram–Schmidt against the vectors so far
-    for (int k = 0; k < basis.count; ++k) {
-      double dot = 0;
-      for (int i = 0; i < area_; ++i) dot += vector[i] * basis.vectors[k * area_ + i];
-      for (int i = 0; i < area_; ++i) vector[i] -= dot * basis.vectors[k * area_ + i];
-    }
-    double norm = 0;
-    for (double value : vector) norm += value * value;
-    if (norm < 1e-9) return;
-    norm = std::sqrt(norm);
-    for (int i = 0; i < area_; ++i) basis.vectors[basis.count * area_ + i] = static_cast<float>(vector[i] / norm);
-    ++basis.count;
-  };
-  std::vector<double> ones(area_, 1.0), along_u(area_), along_v(area_), appearance(patch, patch + area_);
+void KltTracker::DetrendedUnitPatch(const float* patch, const Trend& trend, float* out) const {
+  // The patch minus its mean and linear trend is orthogonal to 1, u and v (the window is
+  // symmetric); normalised, it completes the orthonormal appearance basis.
+  double norm = 0;
   for (int i = 0; i < area_; ++i) {
-    along_u[i] = i % window_ - half_;
-    along_v[i] = i / window_ - half_;
+    out[i] = static_cast<float>(patch[i] - trend.mean - trend.slope_u * (i % window_ - half_) -
+                                trend.slope_v * (i / window_ - half_));
+    norm += static_cast<double>(out[i]) * out[i];
   }
-  add(ones);
-  add(along_u);
-  add(along_v);
-  add(appearance);
-  return basis;
+  const float scale = norm > 1e-9 ? static_cast<float>(1.0 / std::sqrt(norm)) : 0.f;
+  for (int i = 0; i < area_; ++i) out[i] *= scale;
 }
 
-void KltTracker::AppearanceBasis::ProjectOut(float* image) const {
-  for (int k = 0; k < count; ++k) {
-    const float* basis_vector = &vectors[static_cast<size_t>(k) * area];
-    double dot = 0;
-    for (int i = 0; i < area; ++i) dot += image[i] * basis_vector[i];
-    for (int i = 0; i < area; ++i) image[i] -= static_cast<float>(dot) * basis_vector[i];
+void KltTracker::ProjectOutAppearance(const float* unit_patch, float* image) const {
+  // Components along 1, u, v (orthogonal: remove them one by one), then along the patch.
+  double sum = 0, along_u = 0, along_v = 0;
+  for (int i = 0; i < area_; ++i) {
+    sum += image[i];
+    along_u += image[i] * (i % window_ - half_);
+    along_v += image[i] * (i / window_ - half_);
   }
+  const double mean = sum / area_, slope_u = along_u / moment_uu_, slope_v = along_v / moment_uu_;
+  double along_patch = 0;
+  for (int i = 0; i < area_; ++i) {
+    image[i] -= static_cast<float>(mean + slope_u * (i % window_ - half_) + slope_v * (i / window_ - half_));
+    along_patch += static_cast<double>(image[i]) * unit_patch[i];
+  }
+  for (int i = 0; i < area_; ++i) image[i] -= static_cast<float>(along_patch) * unit_patch[i];
 }
 
-KltTracker::Trend KltTracker::WindowTrend(const float* window) const {
-  double sum = 0, squares = 0, along_u = 0, along_v = 0;
-  for (int r = 0; r < window_; ++r) {
-    const double v = r - half_;
-    for (int col = 0; col < window_; ++col) {
-      const double value = window[r * window_ + col];
-      sum += value;
-      squares += value * value;
-      along_u += value * (col - half_);
-      along_v += value * v;
-    }
-  }
+KltTracker::Trend KltTracker::TrendFromSums(const WindowSums& sums) const {
   Trend trend;
-  trend.mean = sum / area_;
-  trend.slope_u = along_u / moment_uu_;
-  trend.slope_v = along_v / moment_uu_;
-  trend.deviation = std::sqrt(std::max(
-      0.0, (squares - area_ * trend.mean * trend.mean - along_u * trend.slope_u - along_v * trend.slope_v) / area_));
+  trend.mean = sums.sum / area_;
+  trend.slope_u = sums.along_u / moment_uu_;
+  trend.slope_v = sums.along_v / moment_uu_;
+  trend.deviation = std::sqrt(std::max(0.0, (sums.squares - area_ * trend.mean * trend.mean -
+                                             sums.along_u * trend.slope_u - sums.along_v * trend.slope_v) /
+                                                area_));
   return trend;
 }
 
+KltTracker::Trend KltTracker::WindowTrend(const float* window) const {
+  WindowSums sums;
+  for (int r = 0; r < window_; ++r) {
+    const float v = static_cast<float>(r - half_);
+    const float* w = window + r * window_;
+    float sum = 0.f, squares = 0.f, along_u = 0.f;
+#pragma omp simd reduction(+ : sum, squares, along_u)
+    for (int col = 0; col < window_; ++col) {
+      sum += w[col];
+      squares += w[col] * w[col];
+      along_u += w[col] * static_cast<float>(col - half_);
+    }
+    sums.sum += sum;
+    sums.squares += squares;
+    sums.along_u += along_u;
+    sums.along_v += v * sum;
+  }
+  return TrendFromSums(sums);
+}
+
+void KltTracker::AccumulateTranslated(const cv::Mat& image, float x, float y, const float* gx, const float* gy,
+                                      WindowSums* sums) const {
+  const BilinearTaps t = TapsAt(x - static_cast<float>(half_), y - static_cast<float>(half_));
+  const float w00 = t.w00, w01 = t.w01, w10 = t.w10, w11 = t.w11;
+  for (int r = 0; r < window_; ++r) {
+    const float* row0 = image.ptr<float>(t.y0 + r) + t.x0;
+    const float* row1 = image.ptr<float>(t.y0 + r + 1) + t.x0;
+    const float* gx_row = gx + r * window_;
+    const float* gy_row = gy + r * window_;
+    float sum = 0.f, squares = 0.f, along_u = 0.f, gx_j = 0.f, gy_j = 0.f;
+#pragma omp simd reduction(+ : sum, squares, along_u, gx_j, gy_j)
+    for (int col = 0; col < window_; ++col) {
+      const float j = w00 * row0[col] + w01 * row0[col + 1] + w10 * row1[col] + w11 * row1[col + 1];
+      sum += j;
+      squares += j * j;
+      along_u += j * static_cast<float>(col - half_);
+      gx_j += gx_row[col] * j;
+      gy_j += gy_row[col] * j;
+    }
+    sums->sum += sum;
+    sums->squares += squares;
+    sums->along_u += along_u;
+    sums->along_v += static_cast<float>(r - half_) * sum;
+    sums->gx_j += gx_j;
+    sums->gy_j += gy_j;
+  }
+}
+
 KltTracker::Photometric KltTracker::FitPhotometric(size_t slot, const float* window) const {
-  const Trend current = WindowTrend(window);
+  return FitTrend(slot, WindowTrend(window));
+}
+
+KltTracker::Photometric KltTracker::FitFromSums(size_t slot, const WindowSums& sums) const {
+  return FitTrend(slot, TrendFromSums(sums));
+}
+
+KltTracker::Photometric KltTracker::FitTrend(size_t slot, const Trend& current) const {
   const Trend& reference = reference_trend_[slot];
   Photometric fit;
   fit.gain = current.deviation > 1e-3 ? std::clamp(static_cast<float>(reference.deviation / current.deviation), 0.2f, 5.f)
@@ -222,6 +270,7 @@ void KltTracker::SetReference(const ImagePyramid& reference, const std::vector<c
 #pragma omp parallel
   {
     std::vector<float> border(static_cast<size_t>(padded) * padded);
+    std::vector<float> unit_patch_buffer(area_);
 #pragma omp for schedule(dynamic, 16)
     for (long p = 0; p < static_cast<long>(points.size()); ++p) {
       for (int level = 0; level < levels_; ++level) {
@@ -258,7 +307,9 @@ void KltTracker::SetReference(const ImagePyramid& reference, const std::vector<c
         // Project out the appearance model: the photometric fit absorbs any error along
         // 1, u, v and the patch itself, so the steps must not count gradients along them
         // (Baker & Matthews' project-out inverse compositional algorithm).
-        const AppearanceBasis basis = MakeAppearanceBasis(patch);
+        reference_trend_[slot] = WindowTrend(patch);
+        float* unit_patch = unit_patch_buffer.data();
+        DetrendedUnitPatch(patch, reference_trend_[slot], unit_patch);
         std::vector<float>& steepest = projected[omp_get_thread_num()];
         const int images = level == 0 ? 6 : 2;
         for (int k = 0; k < images; ++k) {
@@ -271,7 +322,7 @@ void KltTracker::SetReference(const ImagePyramid& reference, const std::vector<c
               sd[i] = values[k];
             }
           }
-          basis.ProjectOut(sd);
+          ProjectOutAppearance(unit_patch, sd);
         }
         std::copy_n(steepest.data(), area_, gx);
         std::copy_n(steepest.data() + area_, area_, gy);
@@ -288,7 +339,6 @@ void KltTracker::SetReference(const ImagePyramid& reference, const std::vector<c
         inverse[0] = static_cast<float>(c / determinant);
         inverse[1] = static_cast<float>(-b / determinant);
         inverse[2] = static_cast<float>(a / determinant);
-        reference_trend_[slot] = WindowTrend(patch);
         level_valid_[slot] = 1;
         if (level == 0) {
           // Steepest-descent images of the affine refinement, [gx, gy, gx·u, gx·v, gy·u, gy·v]
@@ -334,7 +384,6 @@ KltResult KltTracker::TrackFrom(const ImagePyramid& current, size_t index, const
   const float max_shift2 = static_cast<float>(options_.max_displacement_px * options_.max_displacement_px);
   const float top_scale = 1.f / static_cast<float>(1 << (levels - 1));
   float x = guess.x * top_scale, y = guess.y * top_scale;
-  float gain = 1.f, bias = 0.f;
 
   for (int level = levels - 1; level >= 0; --level) {
     if (level < levels - 1) {
@@ -344,8 +393,7 @@ KltResult KltTracker::TrackFrom(const ImagePyramid& current, size_t index, const
     const size_t slot = index * levels_ + level;
     if (!level_valid_[slot]) continue;  // no patch here: carry the estimate down
     const cv::Mat& image = current.level(level);
-    const float* patch = &patch_[slot * area_];
-    const float* gx = &gradient_x_[slot * area_];
+      const float* gx = &gradient_x_[slot * area_];
     const float* gy = &gradient_y_[slot * area_];
     const float* inverse = &inverse_normal_[slot * 3];
     const float start_x = x, start_y = y;
@@ -357,19 +405,14 @@ KltResult KltTracker::TrackFrom(const ImagePyramid& current, size_t index, const
         }
         break;
       }
-      SampleWindow(image, x, y, window_, warped);
-      const Photometric fit = FitPhotometric(slot, warped);
-      Correct(fit, warped);
-      gain = fit.gain;
-      bias = fit.bias;
-      float bx = 0.f, by = 0.f;
-      for (int i = 0; i < area_; ++i) {
-        const float error = warped[i] - patch[i];
-        bx += gx[i] * error;
-        by += gy[i] * error;
-      }
-      const float step_x = inverse[0] * bx + inverse[1] * by;
-      const float step_y = inverse[1] * bx + inverse[2] * by;
+      // One pass: sample the window and accumulate what the step needs. The steepest-descent
+      // images are orthogonal to 1, u, v and the patch, so the fitted bias plane drops out of
+      // the step and the gain only scales it: b = gain · Σ ∇T · J.
+      WindowSums sums;
+      AccumulateTranslated(image, x, y, gx, gy, &sums);
+      const float gain = FitFromSums(slot, sums).gain;
+      const float step_x = gain * (inverse[0] * sums.gx_j + inverse[1] * sums.gy_j);
+      const float step_y = gain * (inverse[1] * sums.gx_j + inverse[2] * sums.gy_j);
       x -= step_x;
       y -= step_y;
       if ((x - start_x) * (x - start_x) + (y - start_y) * (y - start_y) > max_shift2) {
@@ -381,8 +424,6 @@ KltResult KltTracker::TrackFrom(const ImagePyramid& current, size_t index, const
     }
   }
   result.position = cv::Point2f(x, y);
-  result.gain = gain;
-  result.bias = bias;
   const cv::Mat& base = current.level(0);
   if (!WindowInside(base, x, y, half_)) {
     result.status = KltStatus::kOutOfImage;
@@ -422,21 +463,43 @@ void KltTracker::SampleAffine(const cv::Mat& image, float x, float y, const floa
 }
 
 void KltTracker::RefineAffine(const cv::Mat& image, size_t slot, float* x, float* y, float* linear, float* warped) const {
-  const float* patch = &patch_[slot * area_];
   const float* steepest = &affine_steepest_[(slot / levels_) * 6 * area_];
   const double* normal = &affine_normal_[(slot / levels_) * 36];
   const float start_x = *x, start_y = *y;
   float best_x = *x, best_y = *y;
-  for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+  for (int iteration = 0; iteration < options_.affine_iterations; ++iteration) {
     // The warped window's corners must stay inside the image (its reach is at most ~1.5 half).
     if (!WindowInside(image, *x, *y, 2 * half_)) break;
+    // As in translation, the projected steepest-descent images make b = gain · Σ SD · J.
+    double sd_j[6] = {0, 0, 0, 0, 0, 0};
+    WindowSums sums;
     SampleAffine(image, *x, *y, linear, warped);
-    Correct(FitPhotometric(slot, warped), warped);
-    double b[6] = {0, 0, 0, 0, 0, 0};
-    for (int i = 0; i < area_; ++i) {
-      const double error = warped[i] - patch[i];
-      for (int k = 0; k < 6; ++k) b[k] += steepest[k * area_ + i] * error;
+    for (int r = 0; r < window_; ++r) {
+      const float* w = warped + r * window_;
+      float sum = 0.f, squares = 0.f, along_u = 0.f;
+      float products[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+#pragma omp simd reduction(+ : sum, squares, along_u)
+      for (int col = 0; col < window_; ++col) {
+        sum += w[col];
+        squares += w[col] * w[col];
+        along_u += w[col] * static_cast<float>(col - half_);
+      }
+      for (int k = 0; k < 6; ++k) {
+        const float* sd = steepest + static_cast<size_t>(k) * area_ + r * window_;
+        float dot = 0.f;
+#pragma omp simd reduction(+ : dot)
+        for (int col = 0; col < window_; ++col) dot += sd[col] * w[col];
+        products[k] = dot;
+      }
+      sums.sum += sum;
+      sums.squares += squares;
+      sums.along_u += along_u;
+      sums.along_v += static_cast<float>(r - half_) * sum;
+      for (int k = 0; k < 6; ++k) sd_j[k] += products[k];
     }
+    const double gain = FitFromSums(slot, sums).gain;
+    double b[6];
+    for (int k = 0; k < 6; ++k) b[k] = gain * sd_j[k];
     double step[6];
     if (!SolveSymmetric6(normal, b, step)) return;  // not enough texture for six parameters
     // Inverse compositional update: W ← W ∘ W(Δ)⁻¹, W(Δ): q ↦ (I + ΔD) q + Δc.
@@ -466,10 +529,10 @@ void KltTracker::RefineAffine(const cv::Mat& image, size_t slot, float* x, float
     }
     best_x = *x;
     best_y = *y;
-    if (dx * dx + dy * dy < options_.epsilon_px * options_.epsilon_px && std::abs(step[2]) + std::abs(step[3]) +
-                                                                                 std::abs(step[4]) + std::abs(step[5]) < 1e-4) {
-      break;
-    }
+    // Converged when no pixel of the window moves by more than epsilon.
+    const double corner_motion = std::hypot(dx, dy) + half_ * (std::abs(step[2]) + std::abs(step[3]) +
+                                                                std::abs(step[4]) + std::abs(step[5]));
+    if (corner_motion < options_.epsilon_px) break;
   }
 }
 

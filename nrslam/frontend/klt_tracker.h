@@ -78,15 +78,20 @@ class KltTracker {
   struct Photometric {
     float gain = 1.f, bias = 0.f, slope_u = 0.f, slope_v = 0.f;
   };
-  // Orthonormal basis of what the photometric fit absorbs: 1, u, v and the patch itself.
-  struct AppearanceBasis {
-    std::vector<float> vectors;
-    int count = 0;
-    int area = 0;
-    void ProjectOut(float* image) const;
+  // The appearance the photometric fit absorbs is spanned by 1, u, v and the patch; these
+  // remove it from a steepest-descent image (project-out).
+  void DetrendedUnitPatch(const float* patch, const Trend& trend, float* out) const;
+  void ProjectOutAppearance(const float* unit_patch, float* image) const;
+  // Running sums over a window J: Σ J, Σ J², Σ J·u, Σ J·v, and Σ ∇T·J for the step.
+  struct WindowSums {
+    double sum = 0, squares = 0, along_u = 0, along_v = 0, gx_j = 0, gy_j = 0;
   };
-  AppearanceBasis MakeAppearanceBasis(const float* patch) const;
+  Trend TrendFromSums(const WindowSums& sums) const;
   Trend WindowTrend(const float* window) const;
+  void AccumulateTranslated(const cv::Mat& image, float x, float y, const float* gx, const float* gy,
+                            WindowSums* sums) const;
+  Photometric FitTrend(size_t slot, const Trend& current) const;
+  Photometric FitFromSums(size_t slot, const WindowSums& sums) const;
   Photometric FitPhotometric(size_t slot, const float* window) const;  // gain and bias plane
   Photometric FitGainBias(size_t slot, const float* window) const;    // gain and constant bias
   void Correct(const Photometric& fit, float* window) const;
