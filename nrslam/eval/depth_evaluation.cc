@@ -1,0 +1,126 @@
+#include "nrslam/eval/depth_evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+void EvaluationOptions::Check() const {
+  CheckOption(keep_fraction > 0 && keep_fraction <= 1, "evaluation", "keep_fraction must be in (0, 1]");
+  CheckOption(iterations >= 1, "evaluation", "iterations must be >= 1");
+  CheckOption(min_points >= 1, "evaluation", "min_points must be >= 1");
+}
+
+std::optional<double> SampleDepth(const cv::Mat& depth_mm, const cv::Point2d& pixel) {
+  if (depth_mm.type() != CV_32F) throw Error("SampleDepth: expected a CV_32F depth map");
+  if (!std::isfinite(pixel.x) || !std::isfinite(pixel.y)) return std::nullopt;
+  const int x0 = static_cast<int>(std::floor(pixel.x)), y0 = static_cast<int>(std::floor(pixel.y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= depth_mm.cols || y0 + 1 >= depth_mm.rows) {
+    // On the last row or column a sample exactly on the pixel centre is still fine.
+    if (x0 >= 0 && y0 >= 0 && x0 < depth_mm.cols && y0 < depth_mm.rows && pixel.x == x0 && pixel.y == y0) {
+      const float value = depth_mm.at<float>(y0, x0);
+      if (value > 0 && std::isfinite(value)) return value;
+    }
+    return std::nullopt;
+  }
+  const double ax = pixel.x - x0, ay = pixel.y - y0;
+  const float d00 = depth_mm.at<float>(y0, x0), d01 = depth_mm.at<float>(y0, x0 + 1);
+  const float d10 = depth_mm.at<float>(y0 + 1, x0), d11 = depth_mm.at<float>(y0 + 1, x0 + 1);
+  for (float d : {d00, d01, d10, d11}) {
+    if (!(d > 0) || !std::isfinite(d)) return std::nullopt;  // an edge or a hole: no reliable truth
+  }
+  return (1 - ay) * ((1 - ax) * d00 + ax * d01) + ay * ((1 - ax) * d10 + ax * d11);
+}
+
+FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
+                                   const EvaluationOptions& options) {
+  if (estimated.size() != groundtruth.size()) throw Error("EvaluateDepthPairs: size mismatch");
+  FrameEvaluation result;
+  result.points_used = static_cast<int>(estimated.size());
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    if (!std::isfinite(estimated[i]) || !std::isfinite(groundtruth[i])) {
+      throw Error("EvaluateDepthPairs: non-finite depth at point " + std::to_string(i));
+    }
+  }
+  if (result.points_used < options.min_points) return result;
+  const size_t count = estimated.size();
+  const size_t keep = std::max<size_t>(1, static_cast<size_t>(std::floor(options.keep_fraction * count)));
+  std::vector<size_t> order(count);
+  std::vector<double> squared(count);
+  double scale = 1.0;
+  double kept_sum = 0.0;
+  for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    for (size_t i = 0; i < count; ++i) {
+      const double residual = groundtruth[i] - scale * estimated[i];
+      squared[i] = residual * residual;
+    }
+    std::iota(order.begin(), order.end(), 0);
+    // Ties broken by index, so the kept set never depends on the sort's whims.
+    std::nth_element(order.begin(), order.begin() + (keep - 1), order.end(), [&](size_t a, size_t b) {
+      return squared[a] != squared[b] ? squared[a] < squared[b] : a < b;
+    });
+    double cross = 0.0, energy = 0.0;
+    for (size_t k = 0; k < keep; ++k) {
+      cross += groundtruth[order[k]] * estimated[order[k]];
+      energy += estimated[order[k]] * estimated[order[k]];
+    }
+    if (!(energy > 0)) return result;  // all kept estimates at zero depth: no scale
+    scale = cross / energy;
+    kept_sum = 0.0;
+    for (size_t k = 0; k < keep; ++k) {
+      const double residual = groundtruth[order[k]] - scale * estimated[order[k]];
+      kept_sum += residual * residual;
+    }
+  }
+  result.evaluated = true;
+  result.points_kept = static_cast<int>(keep);
+  result.scale = scale;
+  result.squared_error_sum = kept_sum;
+  result.rmse_mm = std::sqrt(kept_sum / keep);
+  return result;
+}
+
+FrameEvaluation EvaluateFrame(const std::vector<DepthPoint>& points, const cv::Mat& depth_mm,
+                              const EvaluationOptions& options) {
+  std::vector<double> estimated, groundtruth;
+  int without = 0;
+  for (const DepthPoint& point : points) {
+    const auto truth = SampleDepth(depth_mm, point.pixel);
+    if (!truth || !std::isfinite(point.depth)) {
+      ++without;
+      continue;
+    }
+    estimated.push_back(point.depth);
+    groundtruth.push_back(*truth);
+  }
+  FrameEvaluation result = EvaluateDepthPairs(estimated, groundtruth, options);
+  result.points_without_groundtruth = without;
+  return result;
+}
+
+SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames) {
+  SequenceMetrics metrics;
+  std::vector<double> rmses;
+  double squared = 0.0;
+  long kept = 0;
+  for (const FrameEvaluation& frame : frames) {
+    if (!frame.evaluated) continue;
+    rmses.push_back(frame.rmse_mm);
+    squared += frame.squared_error_sum;
+    kept += frame.points_kept;
+  }
+  metrics.frames_evaluated = static_cast<int>(rmses.size());
+  if (rmses.empty()) return metrics;
+  metrics.rmse_mm = std::accumulate(rmses.begin(), rmses.end(), 0.0) / rmses.size();
+  std::sort(rmses.begin(), rmses.end());
+  const size_t n = rmses.size();
+  metrics.rmse_median_mm = n % 2 ? rmses[n / 2] : 0.5 * (rmses[n / 2 - 1] + rmses[n / 2]);
+  metrics.rmse_pooled_mm = std::sqrt(squared / kept);
+  return metrics;
+}
+
+}  // namespace nrslam

@@ -1,0 +1,62 @@
+// eval: depth RMSE against ground truth, exactly as the paper computes it.
+//
+// Per frame, for every point tracked with 3D: its camera-frame depth z_est and the ground
+// truth z_gt, sampled bilinearly at the point's sub-pixel position (points whose four
+// neighbouring ground-truth pixels are not all valid are excluded and counted). The scale s
+// comes from trimmed least squares: s = 1, then 10 times: keep the 95 % smallest squared
+// residuals (z_gt − s·z_est)², s ← Σ z_gt·z_est / Σ z_est² over them, RMSE ← √(mean kept
+// squared residual) with the new s. The RMSE is in ground-truth units (mm).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <vector>
+
+namespace nrslam {
+
+struct EvaluationOptions {
+  double keep_fraction = 0.95;  // fraction of the smallest residuals kept by the trimming
+  int iterations = 10;          // trimmed least-squares rounds
+  int min_points = 5;           // fewer evaluable points: the frame has no RMSE
+  void Check() const;
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EvaluationOptions, keep_fraction, iterations, min_points)
+
+struct DepthPoint {
+  cv::Point2d pixel;  // sub-pixel image position
+  double depth;       // estimated camera-frame depth z_est, map units
+};
+
+struct FrameEvaluation {
+  bool evaluated = false;  // false when fewer than min_points had ground truth
+  int points_used = 0;     // points with valid ground truth
+  int points_kept = 0;     // after trimming
+  int points_without_groundtruth = 0;
+  double scale = 0.0;      // s: map units → mm
+  double rmse_mm = 0.0;
+  double squared_error_sum = 0.0;  // over the kept points, for pooled aggregates
+};
+
+// Bilinear sample of a depth map (CV_32F, 0 = none); nullopt unless all four taps are valid.
+std::optional<double> SampleDepth(const cv::Mat& depth_mm, const cv::Point2d& pixel);
+
+// The trimmed least-squares scale and RMSE of (z_est, z_gt) pairs.
+FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
+                                   const EvaluationOptions& options);
+
+// Samples the ground truth at every point, then EvaluateDepthPairs.
+FrameEvaluation EvaluateFrame(const std::vector<DepthPoint>& points, const cv::Mat& depth_mm,
+                              const EvaluationOptions& options);
+
+// Sequence figures with the key names of summary.json.
+struct SequenceMetrics {
+  double rmse_mm = 0.0;         // mean of frame RMSEs (the paper's headline)
+  double rmse_median_mm = 0.0;
+  double rmse_pooled_mm = 0.0;  // √(Σ kept squared errors / Σ kept points) over all frames
+  int frames_evaluated = 0;
+};
+SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames);
+
+}  // namespace nrslam

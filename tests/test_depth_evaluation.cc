@@ -1,0 +1,109 @@
+// Known-answer tests of the evaluator (design README §5).
+#include <gtest/gtest.h>
+
+#include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace {
+
+// Estimated depths 1.0 … 2.98 (map units); pairs (i, i+1) share a depth, so ± noise on them
+// leaves the least-squares scale exact.
+std::vector<double> Estimates(int pairs) {
+  std::vector<double> z;
+  for (int i = 0; i < pairs; ++i) {
+    z.push_back(1.0 + 0.02 * i);
+    z.push_back(1.0 + 0.02 * i);
+  }
+  return z;
+}
+
+TEST(DepthEvaluation, ScaledGroundTruthWithKnownNoiseGivesKnownScaleAndRmse) {
+  // 190 points at ±0.4 mm around 30× the estimate, plus 10 gross outliers (5 %): trimming
+  // must drop exactly the outliers, leaving scale 30 and RMSE 0.4.
+  const std::vector<double> estimated = Estimates(100);
+  std::vector<double> truth;
+  for (size_t i = 0; i < estimated.size(); ++i) truth.push_back(30.0 * estimated[i] + (i % 2 ? 0.4 : -0.4));
+  for (int pair = 0; pair < 5; ++pair) {  // whole pairs, so the kept noise stays balanced
+    truth[40 * pair] += 90.0;
+    truth[40 * pair + 1] -= 60.0;
+  }
+  const FrameEvaluation result = EvaluateDepthPairs(estimated, truth, EvaluationOptions{});
+  ASSERT_TRUE(result.evaluated);
+  EXPECT_EQ(result.points_kept, 190);  // floor(0.95 · 200)
+  EXPECT_NEAR(result.scale, 30.0, 1e-9);
+  EXPECT_NEAR(result.rmse_mm, 0.4, 1e-9);
+}
+
+TEST(DepthEvaluation, WithoutTrimmingItIsPlainLeastSquares) {
+  const std::vector<double> estimated = Estimates(50);
+  std::vector<double> truth;
+  for (size_t i = 0; i < estimated.size(); ++i) truth.push_back(12.5 * estimated[i] + (i % 2 ? 0.3 : -0.3));
+  EvaluationOptions untrimmed;
+  untrimmed.keep_fraction = 1.0;
+  const FrameEvaluation result = EvaluateDepthPairs(estimated, truth, untrimmed);
+  EXPECT_NEAR(result.scale, 12.5, 1e-9);
+  EXPECT_NEAR(result.rmse_mm, 0.3, 1e-9);
+}
+
+TEST(DepthEvaluation, OutliersWithinTheTrimmedFivePercentDoNotMoveIt) {
+  const std::vector<double> estimated = Estimates(100);
+  std::vector<double> truth;
+  for (double z : estimated) truth.push_back(30.0 * z);
+  for (int k : {3, 50, 77, 120, 121, 160, 199}) truth[k] += (k % 2 ? 500.0 : -25.0);  // 3.5 % gross outliers
+  const FrameEvaluation result = EvaluateDepthPairs(estimated, truth, EvaluationOptions{});
+  EXPECT_NEAR(result.scale, 30.0, 1e-9);
+  EXPECT_NEAR(result.rmse_mm, 0.0, 1e-9);
+  // Without trimming they dominate: the check above is not vacuous.
+  EvaluationOptions untrimmed;
+  untrimmed.keep_fraction = 1.0;
+  EXPECT_GT(EvaluateDepthPairs(estimated, truth, untrimmed).rmse_mm, 50.0);
+}
+
+TEST(DepthEvaluation, PointsOnInvalidGroundTruthAreExcludedAndCounted) {
+  cv::Mat depth(40, 60, CV_32F);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 60; ++x) depth.at<float>(y, x) = 20.0f + 0.5f * x;  // a ramp in x
+  }
+  depth(cv::Rect(30, 0, 30, 40)) = 0.0f;  // right half: no ground truth
+  std::vector<DepthPoint> points;
+  for (int i = 0; i < 20; ++i) {
+    const double x = 2.25 + i, y = 10.5;  // sub-pixel, left half
+    points.push_back({{x, y}, (20.0 + 0.5 * x) / 10.0});  // exact at scale 10
+  }
+  points.push_back({{45.0, 10.0}, 1.0});  // right half
+  points.push_back({{29.5, 10.0}, 1.0});  // straddles the hole: one tap invalid
+  points.push_back({{-3.0, 10.0}, 1.0});  // outside the image
+  const FrameEvaluation result = EvaluateFrame(points, depth, EvaluationOptions{});
+  ASSERT_TRUE(result.evaluated);
+  EXPECT_EQ(result.points_used, 20);
+  EXPECT_EQ(result.points_without_groundtruth, 3);
+  EXPECT_NEAR(result.scale, 10.0, 1e-9);  // bilinear sampling recovers the ramp exactly
+  EXPECT_NEAR(result.rmse_mm, 0.0, 1e-9);
+}
+
+TEST(DepthEvaluation, TooFewPointsOrBadInputAreReportedNotGuessed) {
+  EXPECT_FALSE(EvaluateDepthPairs({1.0, 2.0}, {10.0, 20.0}, EvaluationOptions{}).evaluated);
+  EXPECT_THROW(EvaluateDepthPairs({1.0, NAN, 1, 1, 1}, {1, 1, 1, 1, 1}, EvaluationOptions{}), Error);
+  EXPECT_THROW(EvaluateDepthPairs({1.0}, {1.0, 2.0}, EvaluationOptions{}), Error);
+  EXPECT_FALSE(EvaluateDepthPairs({0, 0, 0, 0, 0}, {1, 2, 3, 4, 5}, EvaluationOptions{}).evaluated);
+}
+
+TEST(DepthEvaluation, SequenceAggregates) {
+  std::vector<FrameEvaluation> frames(4);
+  const double rmse[4] = {1.0, 2.0, 4.0, 0.0};
+  for (int i = 0; i < 3; ++i) {
+    frames[i].evaluated = true;
+    frames[i].rmse_mm = rmse[i];
+    frames[i].points_kept = 100;
+    frames[i].squared_error_sum = rmse[i] * rmse[i] * 100;
+  }
+  const SequenceMetrics metrics = AggregateFrames(frames);  // the 4th frame was not evaluated
+  EXPECT_EQ(metrics.frames_evaluated, 3);
+  EXPECT_NEAR(metrics.rmse_mm, 7.0 / 3.0, 1e-12);
+  EXPECT_NEAR(metrics.rmse_median_mm, 2.0, 1e-12);
+  EXPECT_NEAR(metrics.rmse_pooled_mm, std::sqrt(21.0 / 3.0), 1e-12);
+}
+
+}  // namespace
+}  // namespace nrslam
