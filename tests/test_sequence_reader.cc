@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
@@ -19,7 +20,7 @@ constexpr int kFrames = 40;
 class SequenceReaderTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    folder_ = fs::temp_directory_path() / ("nrslam_reader_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    folder_ = UniqueTempFolder("nrslam_reader_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(folder_);
     info_.camera = Camera::Pinhole(40, 30, 30, 30, 19.5, 14.5);
     info_.frame_count = kFrames;

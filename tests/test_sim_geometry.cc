@@ -3,6 +3,7 @@
 
 #include <filesystem>
 
+#include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/sim/colon_scene.h"
 #include "nrslam/sim/lobes_scene.h"
@@ -56,7 +57,7 @@ TEST(SimGeometry, StraightCylinderDepthMatchesTheAnalyticDepth) {
 
 TEST(SimGeometry, StoredDepthPngAddsOnlyQuantisation) {
   const SimOptions options = StraightCylinder();
-  const auto folder = std::filesystem::temp_directory_path() / "nrslam_cylinder";
+  const auto folder = UniqueTempFolder("nrslam_cylinder");
   SimulateSequence(options, "cylinder", folder);
   SequenceReader reader(folder);
   const cv::Mat depth = reader.ReadDepthMm(0);

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/sim/simulate.h"
@@ -30,7 +31,7 @@ SimOptions Small(const std::string& preset) {
 }
 
 TEST(SimRender, SameSeedAndOptionsGiveIdenticalFiles) {
-  const fs::path base = fs::temp_directory_path() / "nrslam_determinism";
+  const fs::path base = UniqueTempFolder("nrslam_determinism");
   fs::remove_all(base);
   SimOptions options = Small("sim-4");
   options.camera.stereo = true;
@@ -102,7 +103,7 @@ TEST(SimRender, ImageDarkensWithDepthBecauseTheLightIsOnTheTip) {
 }
 
 TEST(SimRender, FisheyeWritesItsImageCircleMask) {
-  const fs::path folder = fs::temp_directory_path() / "nrslam_fisheye";
+  const fs::path folder = UniqueTempFolder("nrslam_fisheye");
   SimOptions options = Small("sim-1");
   options.camera.model = "fisheye";
   SimulateSequence(options, "fisheye", folder);

@@ -1,0 +1,183 @@
+#include "nrslam/system/run_sequence.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <chrono>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/io/tum.h"
+#include "nrslam/tracking/tracker.h"
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace fs = std::filesystem;
+namespace {
+
+std::ofstream OpenForWriting(const fs::path& path) {
+  std::ofstream file(path);
+  if (!file) throw Error("cannot write " + path.string());
+  file << std::setprecision(9);
+  return file;
+}
+
+void WritePly(const fs::path& path, const Map& map) {
+  std::ofstream file = OpenForWriting(path);
+  file << "ply\nformat ascii 1.0\nelement vertex " << map.size()
+       << "\nproperty float x\nproperty float y\nproperty float z\n"
+          "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  for (const auto& [id, point] : map.points()) {
+    file << point.position.x() << ' ' << point.position.y() << ' ' << point.position.z() << ' '
+         << int(point.colour[2]) << ' ' << int(point.colour[1]) << ' ' << int(point.colour[0]) << '\n';
+  }
+}
+
+// Estimated depth image: each point a 3x3 splat, mm via the frame's scale when known.
+cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, const cv::Size& size, double unit_mm) {
+  cv::Mat depth = cv::Mat::zeros(size, CV_16UC1);
+  for (const auto& [pixel, depth_mm] : points) {
+    const double value = std::round(depth_mm / unit_mm);
+    if (!(value > 0) || value > 65535) continue;
+    const int cx = cvRound(pixel.x), cy = cvRound(pixel.y);
+    for (int y = std::max(0, cy - 1); y <= std::min(size.height - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(size.width - 1, cx + 1); ++x) {
+        depth.at<uint16_t>(y, x) = static_cast<uint16_t>(value);
+      }
+    }
+  }
+  return depth;
+}
+
+}  // namespace
+
+RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, const fs::path& out,
+                       const RunProgress& progress) {
+  options.Check();
+  const SequenceReader reader(sequence);
+  if (options.run.init == "depth" && !reader.has_depth()) {
+    throw Error("sequence " + sequence.string() + " has no depth/ folder: --init depth needs one");
+  }
+  const int first = std::min(options.run.first_frame, reader.frame_count());
+  const int last = options.run.last_frame < 0 ? reader.frame_count() : std::min(options.run.last_frame, reader.frame_count());
+  if (first >= last) throw Error("the frame range selects no frame of " + sequence.string());
+
+  std::error_code error;
+  fs::create_directories(out / "depth", error);
+  if (error) throw Error("cannot create " + out.string() + ": " + error.message());
+  {
+    std::ofstream config = OpenForWriting(out / "config.json");
+    config << nlohmann::json{{"nrslam_version", NRSLAM_VERSION},
+                             {"sequence", fs::absolute(sequence).string()},
+                             {"sequence_info", reader.info()},
+                             {"options", options}}
+                  .dump(2)
+           << '\n';
+  }
+  std::ofstream points_csv = OpenForWriting(out / "points.csv");
+  points_csv << "frame,point_id,u,v,z_est,x,y,z,status\n";
+  std::ofstream metrics_csv = OpenForWriting(out / "metrics.csv");
+  metrics_csv << "frame,state,points,klt_tracked,outliers,points_without_gt,scale,rmse_mm,ms_klt,ms_pose,"
+                 "ms_deformation,ms_total,note\n";
+  std::ofstream log = OpenForWriting(out / "run.log");
+
+  Tracker tracker(reader.info().camera, options.frontend, options.deformation, options.tracking);
+  RunSummary summary;
+  summary.frames_total = last - first;
+  std::vector<FrameEvaluation> evaluations;
+  std::vector<StampedPose> trajectory;
+  const auto start = std::chrono::steady_clock::now();
+  for (int frame = first; frame < last; ++frame) {
+    FrameResult result;
+    result.frame = frame;
+    cv::Mat depth_mm;
+    try {
+      const cv::Mat bgr = reader.ReadRgb(frame);
+      const cv::Mat mask = reader.ReadMask(frame);
+      if (reader.has_depth()) depth_mm = reader.ReadDepthMm(frame);
+      if (tracker.state() == TrackingState::kTracking) {
+        result = tracker.Track(frame, bgr, mask);
+        if (result.state == TrackingState::kLost) log << "frame " << frame << ": lost (" << result.note << ")\n";
+      } else {
+        result = tracker.InitialiseFromDepth(frame, bgr, depth_mm, mask);
+        if (result.state == TrackingState::kTracking) {
+          if (summary.init_frame < 0) summary.init_frame = frame;
+          log << "frame " << frame << ": map initialised from depth with " << result.points.size() << " points\n";
+        }
+      }
+    } catch (const Error& e) {
+      result.state = TrackingState::kLost;  // an unreadable frame: recorded, and the run goes on
+      result.note = e.what();
+      log << "frame " << frame << ": " << e.what() << '\n';
+    }
+
+    FrameEvaluation evaluation;
+    std::vector<DepthPoint> depth_points;
+    const bool tracked = result.state == TrackingState::kTracking;
+    if (tracked) {
+      ++summary.frames_tracked;
+      trajectory.push_back({frame / reader.info().fps, result.cam_from_world.Inverse()});
+      for (const TrackedPoint& point : result.points) {
+        const Eigen::Vector3d world = tracker.map().point(point.id).position;
+        const double z = (result.cam_from_world * world).z();
+        depth_points.push_back({cv::Point2d(point.pixel.x, point.pixel.y), z});
+        points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
+                   << world.x() << ',' << world.y() << ',' << world.z() << ",tracked\n";
+      }
+      if (!depth_mm.empty()) {
+        evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
+        if (evaluation.evaluated) evaluations.push_back(evaluation);
+      }
+      std::vector<std::pair<cv::Point2f, double>> splats;
+      const double to_mm = evaluation.evaluated ? evaluation.scale : 1.0;
+      for (size_t i = 0; i < result.points.size(); ++i) splats.emplace_back(result.points[i].pixel, to_mm * depth_points[i].depth);
+      const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
+      cv::imwrite((out / "depth" / FrameFileName(frame)).string(), SplatDepth(splats, size, reader.info().depth_unit_mm));
+    } else if (summary.init_frame >= 0) {
+      ++summary.frames_lost;
+    }
+    metrics_csv << frame << ',' << ToString(result.state) << ',' << result.points.size() << ',' << result.klt_tracked
+                << ',' << result.outliers << ',' << evaluation.points_without_groundtruth << ','
+                << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
+                << (evaluation.evaluated ? std::to_string(evaluation.rmse_mm) : std::string()) << ','
+                << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << result.ms_total
+                << ",\"" << result.note << "\"\n";
+    if (progress) {
+      std::ostringstream line;
+      line << "frame " << frame + 1 - first << "/" << summary.frames_total << "  " << ToString(result.state) << "  "
+           << result.points.size() << " points";
+      if (evaluation.evaluated) line << "  RMSE " << std::fixed << std::setprecision(2) << evaluation.rmse_mm << " mm";
+      line << "  " << std::fixed << std::setprecision(1) << result.ms_total << " ms";
+      progress(frame + 1 - first, summary.frames_total, line.str());
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.fps = summary.frames_total / std::max(seconds, 1e-9);
+  const SequenceMetrics metrics = AggregateFrames(evaluations);
+  summary.rmse_mm = metrics.rmse_mm;
+  summary.rmse_median_mm = metrics.rmse_median_mm;
+  summary.rmse_pooled_mm = metrics.rmse_pooled_mm;
+  summary.frames_evaluated = metrics.frames_evaluated;
+
+  WriteTum(out / "trajectory.tum", trajectory);
+  WritePly(out / "map.ply", tracker.map());
+  std::ofstream summary_json = OpenForWriting(out / "summary.json");
+  summary_json << nlohmann::json{{"rmse_mm", summary.rmse_mm},
+                                 {"rmse_median_mm", summary.rmse_median_mm},
+                                 {"rmse_pooled_mm", summary.rmse_pooled_mm},
+                                 {"frames_tracked", summary.frames_tracked},
+                                 {"frames_total", summary.frames_total},
+                                 {"frames_lost", summary.frames_lost},
+                                 {"frames_evaluated", summary.frames_evaluated},
+                                 {"init_frame", summary.init_frame},
+                                 {"fps", summary.fps},
+                                 {"mode", options.tracking.rigid ? "rigid" : "deformable"},
+                                 {"status", summary.init_frame < 0 ? "not_initialised" : "ok"}}
+                      .dump(2)
+               << '\n';
+  return summary;
+}
+
+}  // namespace nrslam

@@ -1,0 +1,39 @@
+// system: runs one sequence offline and writes its run folder:
+//   config.json     every resolved option, the sequence and the version
+//   trajectory.tum  world_from_camera per tracked frame, real timestamps
+//   points.csv      frame, point id, u, v, z_est (camera depth, map units), world X Y Z, status
+//   depth/NNNNNN.png  estimated depth: points splatted at their pixels, in mm (frame scale),
+//                   16-bit in the sequence's depth unit, 0 = none
+//   metrics.csv     per frame: state, points, outliers, scale, RMSE, ms per stage
+//   summary.json    rmse_mm, rmse_median_mm, rmse_pooled_mm, frames_tracked, frames_total,
+//                   init_frame, fps, and the run's status
+//   map.ply         the final map points, coloured
+//   run.log         what happened, in words
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "nrslam/system/system_options.h"
+
+namespace nrslam {
+
+struct RunSummary {
+  double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
+  int frames_tracked = 0;  // frames with a pose after initialisation (the paper's "# Fr.")
+  int frames_total = 0;
+  int frames_lost = 0;
+  int init_frame = -1;
+  int frames_evaluated = 0;
+  double fps = 0;          // frames processed per second of wall time (reading included)
+};
+
+using RunProgress = std::function<void(int frame, int total, const std::string& line)>;
+
+// Throws Error for a bad sequence or options (before anything is written); a lost track is a
+// recorded outcome, not an error.
+RunSummary RunSequence(const std::filesystem::path& sequence, const SystemOptions& options,
+                       const std::filesystem::path& out, const RunProgress& progress = {});
+
+}  // namespace nrslam

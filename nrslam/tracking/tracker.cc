@@ -1,0 +1,335 @@
+#include "nrslam/tracking/tracker.h"
+
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "nrslam/camera/reprojection_cost.h"
+#include "nrslam/deformation/regularizer_costs.h"
+#include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/frontend/feature_detector.h"
+#include "nrslam/frontend/masks.h"
+#include "nrslam/geometry/se3_manifold.h"
+
+namespace nrslam {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double MillisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+cv::Mat Grey(const cv::Mat& bgr) {
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+double SquaredReprojection(const Camera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& point,
+                           const Eigen::Vector2d& observed) {
+  const auto pixel = camera.Project(cam_from_world * point);
+  return pixel ? (*pixel - observed).squaredNorm() : std::numeric_limits<double>::infinity();
+}
+
+ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType solver) {
+  ceres::Solver::Options options;
+  options.max_num_iterations = iterations;
+  options.linear_solver_type = solver;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+}  // namespace
+
+const char* ToString(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialised: return "not_initialised";
+    case TrackingState::kTracking: return "tracking";
+    case TrackingState::kLost: return "lost";
+  }
+  return "unknown";
+}
+
+Tracker::Tracker(const Camera& camera, const FrontendOptions& frontend, const DeformationModelOptions& deformation,
+                 const TrackingOptions& tracking)
+    : camera_(camera),
+      frontend_(frontend),
+      deformation_(deformation),
+      options_(tracking),
+      map_(std::make_unique<Map>(deformation)),
+      klt_(frontend.klt) {
+  camera_.Check();
+  frontend_.Check();
+  deformation_.Check();
+  options_.Check();
+}
+
+FrameResult Tracker::Lost(FrameResult result, const std::string& why) {
+  state_ = state_ == TrackingState::kNotInitialised ? state_ : TrackingState::kLost;
+  result.state = state_;
+  result.note = why;
+  result.points.clear();
+  return result;
+}
+
+FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv::Mat& depth_mm, const cv::Mat& mask) {
+  const auto start = Clock::now();
+  FrameResult result;
+  result.frame = frame;
+  const cv::Mat grey = Grey(bgr);
+  FeatureOptions features = frontend_.features;
+  features.max_features = options_.max_points;
+  const std::vector<cv::Point2f> corners =
+      DetectCorners(grey, BuildValidityMask(grey, mask, frontend_.masks), {}, features);
+  map_ = std::make_unique<Map>(deformation_);
+  tracks_.clear();
+  std::vector<double> depths;
+  std::vector<PointId> ids;
+  for (const cv::Point2f& corner : corners) {
+    const auto depth = SampleDepth(depth_mm, cv::Point2d(corner.x, corner.y));
+    if (!depth) continue;
+    const Eigen::Vector3d bearing = camera_.Unproject(Eigen::Vector2d(corner.x, corner.y));
+    if (bearing.z() <= 1e-6) continue;
+    const Eigen::Vector3d point = bearing * (*depth / bearing.z());
+    const PointId id = map_->AddPoint(point, bgr.at<cv::Vec3b>(cvRound(corner.y), cvRound(corner.x)), frame);
+    ids.push_back(id);
+    depths.push_back(*depth);
+    tracks_.push_back({id, corner, true});
+  }
+  if (static_cast<int>(ids.size()) < options_.min_points) {
+    tracks_.clear();
+    return Lost(result, "too few points with depth to initialise (" + std::to_string(ids.size()) + ")");
+  }
+  double mean = 0, squares = 0;
+  for (double z : depths) {
+    mean += z;
+    squares += z * z;
+  }
+  mean /= depths.size();
+  const double deviation = std::sqrt(std::max(1e-12, squares / depths.size() - mean * mean));
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  map_->set_scale(depths[depths.size() / 2] / 3.0);
+  map_->graph().set_sigma(deformation_.sigma_factor * deviation);
+  map_->graph().ConnectCovisible(ids, {}, map_->Positions());
+
+  cam_from_world_ = Rigid3();
+  motion_ = Rigid3();
+  RefreshReference(grey, mask);
+  state_ = TrackingState::kTracking;
+  result.state = state_;
+  result.cam_from_world = cam_from_world_;
+  for (const PointTrack& track : tracks_) result.points.push_back({track.id, track.pixel});
+  result.klt_tracked = static_cast<int>(tracks_.size());
+  result.ms_total = MillisecondsSince(start);
+  return result;
+}
+
+void Tracker::RefreshReference(const cv::Mat& grey, const cv::Mat& mask) {
+  std::vector<PointTrack> kept;
+  for (const PointTrack& track : tracks_) {
+    if (track.active) kept.push_back(track);
+  }
+  tracks_ = kept;
+  std::vector<cv::Point2f> pixels;
+  for (const PointTrack& track : tracks_) pixels.push_back(track.pixel);
+  klt_.SetReference(ImagePyramid(grey, frontend_.klt.levels), pixels, BuildValidityMask(grey, mask, frontend_.masks));
+  for (size_t i = 0; i < tracks_.size(); ++i) tracks_[i].active = klt_.has_reference(i);
+  frames_since_keyframe_ = 0;
+}
+
+std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const {
+  const PoseParams seed = pose->ToParams();
+  std::vector<bool> inliers(observations.size(), true);
+  std::vector<Eigen::Vector3d> points;
+  for (const Observation& o : observations) points.push_back(map_->point(o.id).position);
+  Se3Manifold manifold;
+  PoseParams params = seed;
+  for (int round = 0; round < options_.pose_rounds; ++round) {
+    params = seed;  // every round restarts from the seed, as the reference does
+    ceres::Problem::Options problem_options;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    problem.AddParameterBlock(params.data(), kPoseParams, &manifold);
+    int used = 0;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (!inliers[i]) continue;
+      problem.AddResidualBlock(CreateReprojectionCost(camera_, observations[i].pixel, options_.pose_sigma_px),
+                               new ceres::HuberLoss(deformation_.huber_reprojection), params.data(), points[i].data());
+      problem.SetParameterBlockConstant(points[i].data());
+      ++used;
+    }
+    if (used < options_.min_points) break;
+    ceres::Solver::Summary summary;
+    ceres::Solve(SolverOptions(options_.pose_iterations, ceres::DENSE_QR), &problem, &summary);
+    const Rigid3 estimate = Rigid3::FromParams(params.data());
+    const double sigma2 = options_.pose_sigma_px * options_.pose_sigma_px;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      inliers[i] = SquaredReprojection(camera_, estimate, points[i], observations[i].pixel) / sigma2 <= options_.outlier_chi2;
+    }
+  }
+  *pose = Rigid3::FromParams(params.data());
+  return inliers;
+}
+
+void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
+                               std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const {
+  const size_t n = observations.size();
+  std::unordered_map<PointId, size_t> index;
+  std::vector<Eigen::Vector3d> points(n);
+  for (size_t i = 0; i < n; ++i) {
+    index[observations[i].id] = i;
+    points[i] = map_->point(observations[i].id).position;
+  }
+  // Regularised pairs: each point's best D edges to other tracked points, each pair once.
+  struct Pair {
+    size_t i, j;
+    double rest_length, weight;
+  };
+  std::vector<Pair> pairs;
+  std::set<std::pair<size_t, size_t>> seen;
+  for (size_t i = 0; i < n; ++i) {
+    for (const GraphNeighbour& neighbour : map_->graph().BestNeighbours(observations[i].id)) {
+      const auto j = index.find(neighbour.id);
+      if (j == index.end()) continue;
+      const auto key = std::minmax(i, j->second);
+      if (!seen.insert(key).second) continue;
+      pairs.push_back({key.first, key.second, map_->graph().edge(neighbour.edge).rest_length, neighbour.weight});
+    }
+  }
+
+  const PoseParams rigid = pose->ToParams();
+  Se3Manifold manifold;
+  inliers->assign(n, true);
+  PoseParams params = rigid;
+  const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
+  for (int round = 0; round < options_.deformation_rounds; ++round) {
+    params = rigid;  // every round restarts from the rigid pose and δ = 0
+    displacements->assign(n, Eigen::Vector3d::Zero());
+    ceres::Problem::Options problem_options;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    problem.AddParameterBlock(params.data(), kPoseParams, &manifold);
+    for (size_t i = 0; i < n; ++i) {
+      problem.AddParameterBlock((*displacements)[i].data(), 3);
+      if (!(*inliers)[i]) continue;
+      problem.AddResidualBlock(
+          CreateDeformedReprojectionCost(camera_, observations[i].pixel, deformation_.reprojection_sigma_px),
+          new ceres::HuberLoss(deformation_.huber_reprojection), params.data(), points[i].data(),
+          (*displacements)[i].data());
+      problem.SetParameterBlockConstant(points[i].data());
+    }
+    for (const Pair& pair : pairs) {
+      double* delta_i = (*displacements)[pair.i].data();
+      double* delta_j = (*displacements)[pair.j].data();
+      problem.AddResidualBlock(
+          ElasticCost::Create(points[pair.i], points[pair.j], pair.rest_length,
+                              ElasticMultiplier(deformation_, pair.rest_length)),
+          new ceres::HuberLoss(deformation_.huber_deformation), delta_i, delta_j);
+      // An outlier's motion is not evidence for its neighbours': its viscous terms go too.
+      if ((*inliers)[pair.i] && (*inliers)[pair.j]) {
+        problem.AddResidualBlock(ViscousCost::Create(ViscousMultiplier(deformation_, pair.weight, map_->scale())),
+                                 new ceres::HuberLoss(deformation_.huber_deformation), delta_i, delta_j);
+      }
+    }
+    ceres::Solver::Summary summary;
+    ceres::Solve(SolverOptions(options_.deformation_iterations, ceres::SPARSE_NORMAL_CHOLESKY), &problem, &summary);
+    const Rigid3 estimate = Rigid3::FromParams(params.data());
+    for (size_t i = 0; i < n; ++i) {
+      (*inliers)[i] = SquaredReprojection(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
+                          sigma2 <=
+                      options_.outlier_chi2;
+    }
+  }
+  *pose = Rigid3::FromParams(params.data());
+}
+
+FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
+  const auto start = Clock::now();
+  FrameResult result;
+  result.frame = frame;
+  if (state_ != TrackingState::kTracking) return Lost(result, "no map to track");
+
+  // Short-term association.
+  const cv::Mat grey = Grey(bgr);
+  const ImagePyramid pyramid(grey, frontend_.klt.levels);
+  std::vector<cv::Point2f> guesses;
+  for (const PointTrack& track : tracks_) {
+    guesses.push_back(track.active ? track.pixel : cv::Point2f(NAN, NAN));
+  }
+  std::vector<KltResult> matches;
+  klt_.Track(pyramid, guesses, frontend_.klt.ssim_tracking, &matches);
+  std::vector<Observation> observations;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (!tracks_[i].active) continue;
+    if (matches[i].status != KltStatus::kTracked) {
+      tracks_[i].active = false;
+      continue;
+    }
+    tracks_[i].pixel = matches[i].position;
+    observations.push_back({i, tracks_[i].id, Eigen::Vector2d(matches[i].position.x, matches[i].position.y)});
+  }
+  result.klt_tracked = static_cast<int>(observations.size());
+  result.ms_klt = MillisecondsSince(start);
+  if (static_cast<int>(observations.size()) < options_.min_points) {
+    return Lost(result, "only " + std::to_string(observations.size()) + " points tracked");
+  }
+
+  // Pose: constant-velocity seed, rigid refinement.
+  const auto pose_start = Clock::now();
+  Rigid3 pose = motion_ * cam_from_world_;
+  std::vector<bool> inliers = RefinePose(observations, &pose);
+  result.ms_pose = MillisecondsSince(pose_start);
+
+  // Deformation.
+  const auto deformation_start = Clock::now();
+  std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
+  std::vector<bool> demoted(observations.size(), false);
+  if (!options_.rigid) {
+    SolveDeformation(observations, &pose, &displacements, &inliers);
+    // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
+    std::vector<double> norms;
+    for (const auto& d : displacements) norms.push_back(d.norm());
+    std::vector<double> sorted = norms;
+    std::sort(sorted.begin(), sorted.end());
+    const double q1 = sorted[sorted.size() / 4], q3 = sorted[(3 * sorted.size()) / 4];
+    const double fence = q3 + options_.displacement_iqr_factor * (q3 - q1);
+    for (size_t i = 0; i < observations.size(); ++i) {
+      demoted[i] = norms[i] >= fence && norms[i] > 0;
+      if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
+    }
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (inliers[i] && !demoted[i]) map_->graph().UpdatePoint(observations[i].id, map_->Positions());
+    }
+  }
+  result.ms_deformation = MillisecondsSince(deformation_start);
+
+  for (size_t i = 0; i < observations.size(); ++i) {
+    const bool weak = !options_.rigid && map_->graph().IsWeaklyConnected(observations[i].id);
+    if (!inliers[i] || demoted[i] || weak) {
+      tracks_[observations[i].track].active = false;
+      ++result.outliers;
+      continue;
+    }
+    result.points.push_back({observations[i].id, tracks_[observations[i].track].pixel});
+  }
+  if (static_cast<int>(result.points.size()) < options_.min_points) {
+    return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");
+  }
+
+  motion_ = pose * cam_from_world_.Inverse();
+  cam_from_world_ = pose;
+  if (++frames_since_keyframe_ >= options_.keyframe_period) RefreshReference(grey, mask);
+  result.state = state_;
+  result.cam_from_world = cam_from_world_;
+  result.ms_total = MillisecondsSince(start);
+  return result;
+}
+
+}  // namespace nrslam

@@ -1,0 +1,17 @@
+#include "nrslam/tracking/tracking_options.h"
+
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+void TrackingOptions::Check() const {
+  CheckOption(max_points >= 10, "tracking", "max_points must be >= 10");
+  CheckOption(keyframe_period >= 1, "tracking", "keyframe_period must be >= 1");
+  CheckOption(min_points >= 3, "tracking", "min_points must be >= 3");
+  CheckOption(pose_rounds >= 1 && pose_iterations >= 1 && deformation_rounds >= 1 && deformation_iterations >= 1,
+              "tracking", "rounds and iterations must be >= 1");
+  CheckOption(pose_sigma_px > 0 && outlier_chi2 > 0 && displacement_iqr_factor > 0, "tracking",
+              "sigma, chi2 and IQR factor must be > 0");
+}
+
+}  // namespace nrslam

@@ -1,0 +1,26 @@
+// tracking: options of per-frame tracking (reference values: reference-behaviour §1.2, §3.2).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+namespace nrslam {
+
+struct TrackingOptions {
+  bool rigid = false;                 // rigid baseline: no displacement variables
+  int max_points = 600;               // map points created at initialisation (strongest corners)
+  int keyframe_period = 6;            // KLT reference patches are refreshed every this many frames
+  int min_points = 10;                // fewer tracked 3D points: the frame is LOST
+  int pose_rounds = 3;                // rigid pose-only refinement: outlier rounds ...
+  int pose_iterations = 10;           // ... of this many LM iterations each
+  double pose_sigma_px = 1.0;         // σ of the rigid refinement's reprojection residuals
+  int deformation_rounds = 2;         // joint pose + displacement problem: outlier rounds ...
+  int deformation_iterations = 10;    // ... of this many LM iterations each
+  double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
+  double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
+  void Check() const;
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
+                                                pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
+                                                deformation_iterations, outlier_chi2, displacement_iqr_factor)
+
+}  // namespace nrslam
