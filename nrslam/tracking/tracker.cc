@@ -281,9 +281,18 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     return Lost(result, "only " + std::to_string(observations.size()) + " points tracked");
   }
 
-  // Pose: constant-velocity seed, rigid refinement.
+  // Pose: constant-velocity seed, rigid refinement. A point that the seed puts behind the
+  // camera (or outside the lens) would make every Ceres evaluation fail: it sits this frame out.
   const auto pose_start = Clock::now();
   Rigid3 pose = motion_ * cam_from_world_;
+  observations.erase(std::remove_if(observations.begin(), observations.end(),
+                                    [&](const Observation& o) {
+                                      return !camera_.Project(pose * map_->point(o.id).position);
+                                    }),
+                     observations.end());
+  if (static_cast<int>(observations.size()) < options_.min_points) {
+    return Lost(result, "only " + std::to_string(observations.size()) + " points in front of the camera");
+  }
   std::vector<bool> inliers = RefinePose(observations, &pose);
   result.ms_pose = MillisecondsSince(pose_start);
 
@@ -311,9 +320,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   result.ms_deformation = MillisecondsSince(deformation_start);
 
   for (size_t i = 0; i < observations.size(); ++i) {
-    const bool weak = !options_.rigid && map_->graph().IsWeaklyConnected(observations[i].id);
-    if (!inliers[i] || demoted[i] || weak) {
+    // An outlier sits this frame out but stays a 2D track: the KLT keeps following it and it
+    // re-enters the next frame's problem (the reference's demotion to TRACKED and re-use).
+    // Only a point the graph has cut loose is dropped for good.
+    if (!options_.rigid && map_->graph().IsWeaklyConnected(observations[i].id)) {
       tracks_[observations[i].track].active = false;
+      ++result.outliers;
+      continue;
+    }
+    if (!inliers[i] || demoted[i]) {
       ++result.outliers;
       continue;
     }
