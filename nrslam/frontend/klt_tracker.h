@@ -47,7 +47,6 @@ class KltTracker {
   // `valid` mask (level-0 size), a level whose window touches an invalid pixel has no patch.
   void SetReference(const ImagePyramid& reference, const std::vector<cv::Point2f>& points, const cv::Mat& valid = {});
   size_t size() const { return points_.size(); }
-  const std::vector<cv::Point2f>& reference_points() const { return points_; }
   bool has_reference(size_t index) const { return level_valid_[index * levels_]; }
 
   // Tracks every reference point into `current`, starting from guesses[i] (level-0 px).

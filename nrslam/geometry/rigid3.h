@@ -48,13 +48,7 @@ struct Rigid3 {
     m.topRightCorner<3, 1>() = translation;
     return m;
   }
-  bool AllFinite() const { return rotation.coeffs().allFinite() && translation.allFinite(); }
 };
-
-// Rotation angle (rad) and translation distance between two transforms.
-inline double RotationAngle(const Rigid3& a, const Rigid3& b) {
-  return a.rotation.angularDistance(b.rotation);
-}
 
 // x_a = T_ab * x_b for a pose parameter block; templated for Ceres Jets.
 template <typename T>

@@ -49,9 +49,6 @@ class Rng {
   double Uniform() { return UnitFromBits(NextBits()); }
   double Uniform(double low, double high) { return low + (high - low) * Uniform(); }
   double Normal() { return NormalFromHash(NextBits()); }
-  int UniformInt(int low, int high_inclusive) {
-    return low + static_cast<int>(Uniform() * (high_inclusive - low + 1));
-  }
 
  private:
   uint64_t state_;
