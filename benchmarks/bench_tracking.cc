@@ -1,0 +1,41 @@
+// Tracking speed at 640x480: frames per second of tracking alone (rendering excluded) and
+// milliseconds per stage, deformable and rigid, on a few presets. Target: >= 30 fps.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "nrslam/sim/renderer.h"
+#include "nrslam/tracking/tracker.h"
+
+int main(int argc, char** argv) {
+  const int frames = argc > 1 ? std::stoi(argv[1]) : 60;
+  std::printf("%-8s %-10s %7s %8s %8s %8s %8s %8s\n", "preset", "mode", "fps", "klt ms", "pose ms", "deform ms",
+              "total ms", "points");
+  for (const std::string preset : {"sim-0", "sim-3", "sim-6"}) {
+    nrslam::Renderer renderer(nrslam::SimPreset(preset));
+    std::vector<nrslam::RenderedFrame> rendered;
+    for (int i = 0; i < frames; ++i) rendered.push_back(renderer.Render(i));
+    for (const bool rigid : {false, true}) {
+      nrslam::TrackingOptions tracking;
+      tracking.rigid = rigid;
+      nrslam::Tracker tracker(renderer.camera(), nrslam::FrontendOptions{}, nrslam::DeformationModelOptions{}, tracking);
+      tracker.InitialiseFromDepth(0, rendered[0].left.bgr, rendered[0].left.depth_mm, {});
+      double klt = 0, pose = 0, deformation = 0, total = 0, points = 0;
+      int tracked = 0;
+      for (int i = 1; i < frames; ++i) {
+        const nrslam::FrameResult result = tracker.Track(i, rendered[i].left.bgr, {});
+        if (result.state != nrslam::TrackingState::kTracking) break;
+        klt += result.ms_klt;
+        pose += result.ms_pose;
+        deformation += result.ms_deformation;
+        total += result.ms_total;
+        points += result.points.size();
+        ++tracked;
+      }
+      const double n = std::max(tracked, 1);
+      std::printf("%-8s %-10s %7.1f %8.2f %8.2f %8.2f %8.2f %8.0f\n", preset.c_str(), rigid ? "rigid" : "deformable",
+                  1000.0 * n / std::max(total, 1e-9), klt / n, pose / n, deformation / n, total / n, points / n);
+    }
+  }
+  return 0;
+}
