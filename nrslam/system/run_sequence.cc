@@ -100,6 +100,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask);
         if (result.state == TrackingState::kLost) log << "frame " << frame << ": lost (" << result.note << ")\n";
+      } else if (tracker.state() == TrackingState::kLost && !options.run.reinitialise_after_loss) {
+        result.state = TrackingState::kLost;
+        result.note = "lost earlier; not re-initialised (run.reinitialise_after_loss=false)";
       } else {
         result = tracker.InitialiseFromDepth(frame, bgr, depth_mm, mask);
         if (result.state == TrackingState::kTracking) {

@@ -15,11 +15,14 @@ namespace nrslam {
 struct RunOptions {
   std::string init = "depth";  // "depth": the first frame's map from the sequence's depth
   bool mapping = false;        // DBA and new points (not available yet)
+  bool reinitialise_after_loss = false;  // with --init depth this rebuilds the map from ground truth,
+                                        // which would flatter a method that loses track: off, as in the
+                                        // paper's tracking experiment (frames after a loss count as lost)
   int first_frame = 0;         // frame range to process, [first_frame, last_frame); -1 = to the end
   int last_frame = -1;
   void Check() const;
 };
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunOptions, init, mapping, first_frame, last_frame)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunOptions, init, mapping, reinitialise_after_loss, first_frame, last_frame)
 
 struct SystemOptions {
   RunOptions run;
