@@ -22,9 +22,19 @@ ColonScene::ColonScene(const SimOptions& options) : options_(options) {
   if (!colon.straight) {
     for (double s = -40.0 + rng.Uniform(0, colon.fold_spacing_max_mm); s < length_mm_ + 40.0;
          s += rng.Uniform(colon.fold_spacing_min_mm, colon.fold_spacing_max_mm)) {
-      folds_.push_back({s, rng.Uniform(colon.fold_height_min_mm, colon.fold_height_max_mm),
-                        rng.Uniform(1.0, kMaxFoldTilt), rng.Uniform(0, kTwoPi)});
+      Fold fold{s, rng.Uniform(colon.fold_height_min_mm, colon.fold_height_max_mm), rng.Uniform(1.0, kMaxFoldTilt),
+                rng.Uniform(0, kTwoPi), 0.0, 0.0};
+      fold.cos_phase = std::cos(fold.phase);
+      fold.sin_phase = std::sin(fold.phase);
+      folds_.push_back(fold);
     }
+  }
+  for (int j = 0; j < colon.angular_steps; ++j) {
+    const double theta = kTwoPi * j / colon.angular_steps;
+    tables_.cos1.push_back(std::cos(theta));
+    tables_.sin1.push_back(std::sin(theta));
+    tables_.cos3.push_back(std::cos(3 * theta));
+    tables_.sin3.push_back(std::sin(3 * theta));
   }
   texture_ = std::make_unique<MucosaTexture>(length_mm_, kTwoPi * colon.radius_mean_mm, true, options.appearance,
                                              SplitMix64(options.seed ^ 0x7e47ULL),
@@ -73,12 +83,17 @@ ColonScene::Ring ColonScene::RingAt(double s) const {
 }
 
 double ColonScene::RingRadius(const Ring& ring, double theta) const {
+  return RingRadius(ring, std::cos(theta), std::sin(theta), std::cos(3 * theta), std::sin(3 * theta));
+}
+
+double ColonScene::RingRadius(const Ring& ring, double cos1, double sin1, double cos3, double sin3) const {
   const double width = options_.colon.fold_width_mm;
   double radius = ring.radius;
   for (size_t k = ring.first_fold; k < ring.end_fold; ++k) {
     const Fold& fold = folds_[k];
-    const double offset = ring.s - (fold.s + fold.tilt * std::sin(theta + fold.phase));
-    const double lobing = 0.65 + 0.35 * std::cos(3.0 * theta + fold.phase);
+    // sin(θ + φ) and cos(3θ + φ) by angle addition.
+    const double offset = ring.s - (fold.s + fold.tilt * (sin1 * fold.cos_phase + cos1 * fold.sin_phase));
+    const double lobing = 0.65 + 0.35 * (cos3 * fold.cos_phase - sin3 * fold.sin_phase);
     radius -= fold.height * lobing * std::exp(-offset * offset / (2.0 * width * width));
   }
   return radius;
@@ -100,10 +115,15 @@ void ColonScene::RowPositions(int, double s, const std::vector<double>& thetas, 
   const Frame frame = CentrelineFrame(s);
   const Eigen::Vector3d centre = Centreline(s);
   const Ring ring = RingAt(s);
+  const bool standard_grid = thetas.size() == tables_.cos1.size();
   for (size_t j = 0; j < thetas.size(); ++j) {
     const double theta = thetas[j];
+    const double cos1 = standard_grid ? tables_.cos1[j] : std::cos(theta);
+    const double sin1 = standard_grid ? tables_.sin1[j] : std::sin(theta);
+    const double cos3 = standard_grid ? tables_.cos3[j] : std::cos(3 * theta);
+    const double sin3 = standard_grid ? tables_.sin3[j] : std::sin(3 * theta);
     const Eigen::Vector3d rest =
-        centre + RingRadius(ring, theta) * (std::cos(theta) * frame.normal + std::sin(theta) * frame.binormal);
+        centre + RingRadius(ring, cos1, sin1, cos3, sin3) * (cos1 * frame.normal + sin1 * frame.binormal);
     out[j] = ApplyWaveDeformation(rest, options_.deformation, time_s);
   }
 }

@@ -38,6 +38,12 @@ class ColonScene : public Scene {
     double height;  // mm
     double tilt;    // the ridge wanders ±tilt mm along s around the lumen
     double phase;   // of the lobing and the tilt, rad
+    double cos_phase, sin_phase;
+  };
+  // sin/cos of θ and 3θ on the standard angular grid (Grid()'s v), so tessellation does no
+  // trigonometry per vertex but the wave's.
+  struct AngularTables {
+    std::vector<double> cos1, sin1, cos3, sin3;
   };
   // What a ring of the tube at s shares: its base radius and the folds that reach it.
   struct Ring {
@@ -59,6 +65,8 @@ class ColonScene : public Scene {
   Frame CentrelineFrame(double s) const;
   Ring RingAt(double s) const;
   double RingRadius(const Ring& ring, double theta) const;
+  double RingRadius(const Ring& ring, double cos1, double sin1, double cos3, double sin3) const;
+  AngularTables tables_;
   double CameraArc(double time_s) const;
 };
 
