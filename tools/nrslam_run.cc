@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "run folder to write")->required();
   app.add_option("--init", init, "depth (map from the sequence's depth) or monocular")->capture_default_str();
   app.add_flag("--rigid", rigid, "rigid baseline: no deformation");
-  app.add_flag("--no-mapping", no_mapping, "tracking only (the paper's Table II experiment)");
+  app.add_flag("--no-mapping", no_mapping, "tracking only (the paper's Table II experiment; the only mode until mapping lands)");
   app.add_option("--set", assignments, "set any option, e.g. --set deformation.k=2 (see --print-options)");
   app.add_flag("--print-options", print_options, "print every option as JSON and exit");
   app.add_flag("--quiet", quiet, "no progress line");
@@ -24,7 +24,6 @@ int main(int argc, char** argv) {
   try {
     nrslam::SystemOptions options;
     options.run.init = init;
-    options.run.mapping = false;  // no_mapping is the only mode so far; mapping comes with DBA
     options.tracking.rigid = rigid;
     options = nrslam::WithAssignments(options, assignments);
     if (print_options) {

@@ -48,11 +48,7 @@ int main(int argc, char** argv) {
       if (!config_path.empty()) {
         std::ifstream file(config_path);
         if (!file) throw nrslam::Error("cannot read " + config_path);
-        nrslam::Json given = nrslam::Json::parse(file);
-        nrslam::Json merged = options;
-        nrslam::RejectUnknownKeys(given, merged, config_path);
-        merged.merge_patch(given);
-        options = merged.get<nrslam::SimOptions>();
+        options = nrslam::OptionsFromJson(nrslam::Json::parse(file), config_path, options);
       }
       if (frames > 0) options.frames = frames;
       if (width > 0) options.camera.width = width;

@@ -313,8 +313,9 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
       demoted[i] = norms[i] >= fence && norms[i] > 0;
       if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
     }
+    const PositionLookup positions = map_->Positions();
     for (size_t i = 0; i < observations.size(); ++i) {
-      if (inliers[i] && !demoted[i]) map_->graph().UpdatePoint(observations[i].id, map_->Positions());
+      if (inliers[i] && !demoted[i]) map_->graph().UpdatePoint(observations[i].id, positions);
     }
   }
   result.ms_deformation = MillisecondsSince(deformation_start);

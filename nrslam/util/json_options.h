@@ -29,10 +29,11 @@ void ApplyAssignment(Json& config, const std::string& assignment);
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
 std::vector<std::string> LeafPaths(const Json& config);
 
-// Parses options from JSON on top of the defaults, rejecting unknown keys, then Check()s.
+// Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
+// rejecting unknown keys, then Check()s.
 template <typename Options>
-Options OptionsFromJson(const Json& given, const std::string& context) {
-  const Json defaults = Options{};
+Options OptionsFromJson(const Json& given, const std::string& context, const Options& base = Options{}) {
+  const Json defaults = base;
   RejectUnknownKeys(given, defaults, context);
   Json merged = defaults;
   merged.merge_patch(given);
