@@ -85,14 +85,17 @@ void DeformationGraph::UpdatePoint(PointId point, const PositionLookup& position
   }
 }
 
-std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point) const {
+std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
+                                                             const std::function<bool(PointId)>& eligible) const {
   std::vector<GraphNeighbour> neighbours;
   const auto list = adjacency_.find(point);
   if (list == adjacency_.end()) return neighbours;
   for (int index : list->second) {
     const GraphEdge& edge = edges_[index];
     if (edge.pruned || edge.weight < options_.min_edge_weight) continue;
-    neighbours.push_back({edge.a == point ? edge.b : edge.a, index, edge.weight});
+    const PointId other = edge.a == point ? edge.b : edge.a;
+    if (eligible && !eligible(other)) continue;
+    neighbours.push_back({other, index, edge.weight});
   }
   const size_t keep = std::min(neighbours.size(), static_cast<size_t>(options_.max_degree_D));
   // Ties broken by id so the choice never depends on insertion order.

@@ -58,8 +58,10 @@ class DeformationGraph {
   // Neighbours without a position keep their edge untouched.
   void UpdatePoint(PointId point, const PositionLookup& position);
 
-  // Up to max_degree_D unpruned edges with b >= min_edge_weight, highest b first.
-  std::vector<GraphNeighbour> BestNeighbours(PointId point) const;
+  // Up to max_degree_D unpruned edges with b >= min_edge_weight, highest b first, to
+  // neighbours that pass `eligible` (all if empty): e.g. only the points tracked this frame,
+  // so lost neighbours do not use up the point's D regularisers.
+  std::vector<GraphNeighbour> BestNeighbours(PointId point, const std::function<bool(PointId)>& eligible = {}) const;
   int GoodEdgeCount(PointId point) const;
   // Fewer than min_good_edges unpruned edges left: the point's deformation is unconstrained.
   bool IsWeaklyConnected(PointId point) const { return GoodEdgeCount(point) < options_.min_good_edges; }

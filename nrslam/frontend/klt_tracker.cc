@@ -251,16 +251,29 @@ KltTracker::KltTracker(const KltOptions& options)
 void KltTracker::SetReference(const ImagePyramid& reference, const std::vector<cv::Point2f>& points,
                               const cv::Mat& valid) {
   levels_ = std::min(options_.levels, reference.levels());
-  points_ = points;
-  const size_t slots = points.size() * levels_;
-  patch_.assign(slots * area_, 0.f);
-  gradient_x_.assign(slots * area_, 0.f);
-  gradient_y_.assign(slots * area_, 0.f);
-  inverse_normal_.assign(slots * 3, 0.f);
-  level_valid_.assign(slots, 0);
-  reference_trend_.assign(slots, Trend());
-  affine_normal_.assign(points.size() * 36, 0.0);
-  affine_steepest_.assign(points.size() * 6 * area_, 0.f);
+  points_.clear();
+  Append(reference, points, valid);
+}
+
+void KltTracker::Append(const ImagePyramid& reference, const std::vector<cv::Point2f>& new_points,
+                        const cv::Mat& valid) {
+  if (points_.empty()) levels_ = std::min(options_.levels, reference.levels());
+  if (reference.levels() < levels_) {
+    throw Error("KltTracker::Append: the pyramid has " + std::to_string(reference.levels()) + " levels, the tracker " +
+                std::to_string(levels_));
+  }
+  const size_t first = points_.size();
+  points_.insert(points_.end(), new_points.begin(), new_points.end());
+  const size_t slots = points_.size() * levels_;
+  patch_.resize(slots * area_, 0.f);
+  gradient_x_.resize(slots * area_, 0.f);
+  gradient_y_.resize(slots * area_, 0.f);
+  inverse_normal_.resize(slots * 3, 0.f);
+  level_valid_.resize(slots, 0);
+  reference_trend_.resize(slots, Trend());
+  affine_normal_.resize(points_.size() * 36, 0.0);
+  affine_steepest_.resize(points_.size() * 6 * area_, 0.f);
+  std::fill(level_valid_.begin() + first * levels_, level_valid_.end(), 0);
   const int padded = window_ + 2;
   // OpenCV's scale (calcOpticalFlowPyrLK's minEigThreshold): eigenvalue of Σ∇I∇Iᵀ over the
   // window area, gradients in grey levels per px, divided by 1024.
@@ -272,12 +285,12 @@ void KltTracker::SetReference(const ImagePyramid& reference, const std::vector<c
     std::vector<float> border(static_cast<size_t>(padded) * padded);
     std::vector<float> unit_patch_buffer(area_);
 #pragma omp for schedule(dynamic, 16)
-    for (long p = 0; p < static_cast<long>(points.size()); ++p) {
+    for (long p = static_cast<long>(first); p < static_cast<long>(points_.size()); ++p) {
       for (int level = 0; level < levels_; ++level) {
         const size_t slot = static_cast<size_t>(p) * levels_ + level;
         const cv::Mat& image = reference.level(level);
         const float scale = 1.f / static_cast<float>(1 << level);
-        const float x = points[p].x * scale, y = points[p].y * scale;
+        const float x = points_[p].x * scale, y = points_[p].y * scale;
         if (!std::isfinite(x) || !std::isfinite(y) || !WindowInside(image, x, y, half_ + 1, CoarseOverhang(level, half_))) {
           continue;
         }

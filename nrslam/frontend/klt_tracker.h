@@ -46,6 +46,9 @@ class KltTracker {
   // Cuts reference patches at `points` on every level of `reference`. With a non-empty
   // `valid` mask (level-0 size), a level whose window touches an invalid pixel has no patch.
   void SetReference(const ImagePyramid& reference, const std::vector<cv::Point2f>& points, const cv::Mat& valid = {});
+  // Adds reference points cut from another image (e.g. a re-found point's patch from the
+  // keyframe it was last seen in); indices continue after the existing ones.
+  void Append(const ImagePyramid& reference, const std::vector<cv::Point2f>& points, const cv::Mat& valid = {});
   size_t size() const { return points_.size(); }
   bool has_reference(size_t index) const { return level_valid_[index * levels_]; }
 

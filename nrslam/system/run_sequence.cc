@@ -79,7 +79,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::ofstream points_csv = OpenForWriting(out / "points.csv");
   points_csv << "frame,point_id,u,v,z_est,x,y,z,status\n";
   std::ofstream metrics_csv = OpenForWriting(out / "metrics.csv");
-  metrics_csv << "frame,state,points,klt_tracked,outliers,points_without_gt,scale,rmse_mm,ms_klt,ms_pose,"
+  metrics_csv << "frame,state,points,klt_tracked,outliers,propagated,reassociated,points_without_gt,scale,rmse_mm,ms_klt,ms_pose,"
                  "ms_deformation,ms_total,note\n";
   std::ofstream log = OpenForWriting(out / "run.log");
 
@@ -127,7 +127,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         const double z = (result.cam_from_world * world).z();
         depth_points.push_back({cv::Point2d(point.pixel.x, point.pixel.y), z});
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
-                   << world.x() << ',' << world.y() << ',' << world.z() << ",tracked\n";
+                   << world.x() << ',' << world.y() << ',' << world.z() << ','
+                   << (point.reassociated ? "reassociated" : "tracked") << '\n';
       }
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
@@ -142,7 +143,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       ++summary.frames_lost;
     }
     metrics_csv << frame << ',' << ToString(result.state) << ',' << result.points.size() << ',' << result.klt_tracked
-                << ',' << result.outliers << ',' << evaluation.points_without_groundtruth << ','
+                << ',' << result.outliers << ',' << result.propagated << ',' << result.reassociated << ','
+                << evaluation.points_without_groundtruth << ','
                 << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
                 << (evaluation.evaluated ? std::to_string(evaluation.rmse_mm) : std::string()) << ','
                 << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << result.ms_total

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "nrslam/camera/reprojection_cost.h"
@@ -90,6 +91,7 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
       DetectCorners(grey, BuildValidityMask(grey, mask, frontend_.masks), {}, features);
   map_ = std::make_unique<Map>(deformation_);
   tracks_.clear();
+  lost_.clear();
   std::vector<double> depths;
   std::vector<PointId> ids;
   for (const cv::Point2f& corner : corners) {
@@ -101,7 +103,7 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
     const PointId id = map_->AddPoint(point, bgr.at<cv::Vec3b>(cvRound(corner.y), cvRound(corner.x)), frame);
     ids.push_back(id);
     depths.push_back(*depth);
-    tracks_.push_back({id, corner, true});
+    tracks_.push_back({id, corner, true, {}});
   }
   if (static_cast<int>(ids.size()) < options_.min_points) {
     tracks_.clear();
@@ -121,7 +123,7 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
 
   cam_from_world_ = Rigid3();
   motion_ = Rigid3();
-  RefreshReference(grey, mask);
+  RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels), grey, mask);
   state_ = TrackingState::kTracking;
   result.state = state_;
   result.cam_from_world = cam_from_world_;
@@ -131,17 +133,112 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
   return result;
 }
 
-void Tracker::RefreshReference(const cv::Mat& grey, const cv::Mat& mask) {
-  std::vector<PointTrack> kept;
-  for (const PointTrack& track : tracks_) {
-    if (track.active) kept.push_back(track);
-  }
-  tracks_ = kept;
+void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& grey,
+                               const cv::Mat& mask) {
+  std::vector<PointTrack> active;
   std::vector<cv::Point2f> pixels;
-  for (const PointTrack& track : tracks_) pixels.push_back(track.pixel);
-  klt_.SetReference(ImagePyramid(grey, frontend_.klt.levels), pixels, BuildValidityMask(grey, mask, frontend_.masks));
-  for (size_t i = 0; i < tracks_.size(); ++i) tracks_[i].active = klt_.has_reference(i);
+  for (const PointTrack& track : tracks_) {
+    if (!track.active) continue;
+    active.push_back(track);
+    pixels.push_back(track.pixel);
+  }
+  const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
+  klt_.SetReference(*keyframe, pixels, valid);
+  tracks_.clear();
+  std::vector<cv::Point2f> kept_pixels;
+  for (size_t i = 0; i < active.size(); ++i) {
+    if (!klt_.has_reference(i)) {
+      LoseTrack(&active[i], frame);  // under the mask here; it may be seen again elsewhere
+      continue;
+    }
+    active[i].patch = {keyframe, active[i].pixel};
+    tracks_.push_back(active[i]);
+    kept_pixels.push_back(active[i].pixel);
+  }
+  // Keep the KLT's reference points aligned with tracks_.
+  if (kept_pixels.size() != active.size()) klt_.SetReference(*keyframe, kept_pixels, valid);
   frames_since_keyframe_ = 0;
+}
+
+void Tracker::LoseTrack(PointTrack* track, int frame) {
+  track->active = false;
+  if (!track->patch.keyframe) return;
+  if (!options_.rigid && map_->graph().IsWeaklyConnected(track->id)) return;
+  lost_[track->id] = {track->patch, frame};
+}
+
+int Tracker::PropagateMotion(const std::unordered_map<PointId, Eigen::Vector3d>& optimised,
+                             const std::vector<PointId>& demoted) {
+  std::vector<PointId> candidates = demoted;
+  for (const auto& entry : lost_) candidates.push_back(entry.first);
+  const auto is_optimised = [&](PointId id) { return optimised.count(id) > 0; };
+  // All moves are computed from this frame's optimised displacements before any is applied,
+  // so the order of the candidates does not matter.
+  std::vector<std::pair<PointId, Eigen::Vector3d>> moves;
+  for (PointId id : candidates) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double total = 0.0;
+    for (const GraphNeighbour& neighbour : map_->graph().BestNeighbours(id, is_optimised)) {
+      const double weight = neighbour.weight * neighbour.weight;
+      sum += weight * optimised.at(neighbour.id);
+      total += weight;
+    }
+    if (total > 0.0) moves.emplace_back(id, sum / total);
+  }
+  for (const auto& [id, move] : moves) map_->point(id).position += move;
+  return static_cast<int>(moves.size());
+}
+
+void Tracker::ForgetLostPoints(int frame) {
+  for (auto it = lost_.begin(); it != lost_.end();) {
+    const bool stale = frame - it->second.lost_frame > options_.lost_max_age_frames;
+    const bool cut_loose = !options_.rigid && map_->graph().IsWeaklyConnected(it->first);
+    it = stale || cut_loose ? lost_.erase(it) : std::next(it);
+  }
+}
+
+void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& grey, const cv::Mat& mask,
+                          FrameResult* result) {
+  if (!options_.reassociation || lost_.empty()) return;
+  // Candidates: projecting far enough inside the image for a whole window and onto valid
+  // pixels (not under the mask, not in a highlight), grouped by the keyframe of their patch.
+  const double margin = frontend_.klt.window_px / 2 + 1;
+  const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
+  std::map<const ImagePyramid*, std::vector<std::pair<PointId, Eigen::Vector2d>>> groups;
+  for (const auto& [id, lost] : lost_) {
+    const auto pixel = camera_.Project(cam_from_world_ * map_->point(id).position);
+    if (!pixel || !camera_.InImage(*pixel, margin)) continue;
+    if (!valid.at<uint8_t>(cvRound(pixel->y()), cvRound(pixel->x()))) continue;
+    groups[lost.patch.keyframe.get()].emplace_back(id, *pixel);
+  }
+  KltOptions search = frontend_.klt;
+  search.levels = std::min(search.levels, options_.reassociation_levels);  // the seed is close
+  for (const auto& [keyframe, candidates] : groups) {
+    std::vector<cv::Point2f> patches, seeds;
+    for (const auto& [id, projection] : candidates) {
+      patches.push_back(lost_.at(id).patch.pixel);
+      seeds.emplace_back(static_cast<float>(projection.x()), static_cast<float>(projection.y()));
+    }
+    KltTracker klt(search);
+    klt.SetReference(*keyframe, patches);
+    std::vector<KltResult> found;
+    klt.Track(pyramid, seeds, frontend_.klt.ssim_reassociation, &found);
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const cv::Point2f offset = found[i].position - seeds[i];
+      if (found[i].status != KltStatus::kTracked ||
+          offset.dot(offset) > options_.reassociation_gate_px2) {
+        continue;
+      }
+      const PointId id = candidates[i].first;
+      const PatchSource patch = lost_.at(id).patch;
+      klt_.Append(*patch.keyframe, {patch.pixel});
+      tracks_.push_back({id, found[i].position, klt_.has_reference(klt_.size() - 1), patch});
+      lost_.erase(id);
+      if (!tracks_.back().active) continue;
+      result->points.push_back({id, found[i].position, true});
+      ++result->reassociated;
+    }
+  }
 }
 
 std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const {
@@ -194,10 +291,10 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
   };
   std::vector<Pair> pairs;
   std::set<std::pair<size_t, size_t>> seen;
+  const auto is_tracked = [&](PointId id) { return index.count(id) > 0; };
   for (size_t i = 0; i < n; ++i) {
-    for (const GraphNeighbour& neighbour : map_->graph().BestNeighbours(observations[i].id)) {
+    for (const GraphNeighbour& neighbour : map_->graph().BestNeighbours(observations[i].id, is_tracked)) {
       const auto j = index.find(neighbour.id);
-      if (j == index.end()) continue;
       const auto key = std::minmax(i, j->second);
       if (!seen.insert(key).second) continue;
       pairs.push_back({key.first, key.second, map_->graph().edge(neighbour.edge).rest_length, neighbour.weight});
@@ -258,18 +355,18 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
 
   // Short-term association.
   const cv::Mat grey = Grey(bgr);
-  const ImagePyramid pyramid(grey, frontend_.klt.levels);
+  const auto pyramid = std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels);
   std::vector<cv::Point2f> guesses;
   for (const PointTrack& track : tracks_) {
     guesses.push_back(track.active ? track.pixel : cv::Point2f(NAN, NAN));
   }
   std::vector<KltResult> matches;
-  klt_.Track(pyramid, guesses, frontend_.klt.ssim_tracking, &matches);
+  klt_.Track(*pyramid, guesses, frontend_.klt.ssim_tracking, &matches);
   std::vector<Observation> observations;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;
     if (matches[i].status != KltStatus::kTracked) {
-      tracks_[i].active = false;
+      LoseTrack(&tracks_[i], frame);
       continue;
     }
     tracks_[i].pixel = matches[i].position;
@@ -314,9 +411,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
       if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
     }
     const PositionLookup positions = map_->Positions();
+    std::unordered_map<PointId, Eigen::Vector3d> optimised;
+    std::vector<PointId> demoted_ids;
     for (size_t i = 0; i < observations.size(); ++i) {
-      if (inliers[i] && !demoted[i]) map_->graph().UpdatePoint(observations[i].id, positions);
+      if (demoted[i]) demoted_ids.push_back(observations[i].id);
+      if (!inliers[i] || demoted[i]) continue;
+      map_->graph().UpdatePoint(observations[i].id, positions);
+      optimised.emplace(observations[i].id, displacements[i]);
     }
+    result.propagated = PropagateMotion(optimised, demoted_ids);
   }
   result.ms_deformation = MillisecondsSince(deformation_start);
 
@@ -335,13 +438,14 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     }
     result.points.push_back({observations[i].id, tracks_[observations[i].track].pixel});
   }
+  motion_ = pose * cam_from_world_.Inverse();
+  cam_from_world_ = pose;
+  ForgetLostPoints(frame);
+  Reassociate(*pyramid, grey, mask, &result);
   if (static_cast<int>(result.points.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");
   }
-
-  motion_ = pose * cam_from_world_.Inverse();
-  cam_from_world_ = pose;
-  if (++frames_since_keyframe_ >= options_.keyframe_period) RefreshReference(grey, mask);
+  if (++frames_since_keyframe_ >= options_.keyframe_period) RefreshReference(frame, pyramid, grey, mask);
   result.state = state_;
   result.cam_from_world = cam_from_world_;
   result.ms_total = MillisecondsSince(start);

@@ -5,14 +5,16 @@
 // rigid pose-only refinement with outlier rounds → (unless rigid) the joint problem of the
 // pose and one displacement δ per point, with reprojection, elastic and viscous terms over
 // the DDG's best edges → demotion of outliers (‖δ‖ beyond the IQR fence, large reprojection
-// error) → graph update and pruning. Too few points left is the LOST state, a recorded
-// outcome, never an exit.
+// error) → graph update and pruning → the optimised motion propagated to lost and demoted
+// neighbours → mid-term re-association of lost points by a KLT seeded at their projection.
+// Too few points left is the LOST state, a recorded outcome, never an exit.
 #pragma once
 
 #include <opencv2/core.hpp>
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "nrslam/camera/camera.h"
@@ -29,7 +31,8 @@ const char* ToString(TrackingState state);
 
 struct TrackedPoint {
   PointId id;
-  cv::Point2f pixel;  // where the KLT found it this frame
+  cv::Point2f pixel;          // where the KLT found it this frame
+  bool reassociated = false;  // found again this frame by mid-term re-association
 };
 
 struct FrameResult {
@@ -39,6 +42,8 @@ struct FrameResult {
   std::vector<TrackedPoint> points;  // 3D points tracked and kept this frame
   int klt_tracked = 0;               // tracks the KLT kept
   int outliers = 0;                  // demoted by the optimisation this frame
+  int propagated = 0;                // lost or demoted points moved with their neighbours
+  int reassociated = 0;              // lost points found again
   double ms_klt = 0, ms_pose = 0, ms_deformation = 0, ms_total = 0;
   std::string note;                  // why a frame is not tracked
 };
@@ -57,10 +62,20 @@ class Tracker {
   const Map& map() const { return *map_; }
 
  private:
+  // Where a track's KLT reference patch was cut: a keyframe and the point's pixel there.
+  struct PatchSource {
+    std::shared_ptr<const ImagePyramid> keyframe;
+    cv::Point2f pixel;
+  };
   struct PointTrack {
     PointId id;
     cv::Point2f pixel;
     bool active;
+    PatchSource patch;
+  };
+  struct LostPoint {
+    PatchSource patch;
+    int lost_frame;
   };
   struct Observation {
     size_t track;   // index into tracks_
@@ -75,17 +90,29 @@ class Tracker {
   std::unique_ptr<Map> map_;
   KltTracker klt_;
   std::vector<PointTrack> tracks_;  // aligned with the KLT's reference points
+  std::unordered_map<PointId, LostPoint> lost_;  // moved with their neighbours; may be found again
   TrackingState state_ = TrackingState::kNotInitialised;
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
   int frames_since_keyframe_ = 0;
 
-  void RefreshReference(const cv::Mat& grey, const cv::Mat& mask);
+  void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& grey,
+                        const cv::Mat& mask);
+  // Stops tracking a point; unless the graph has cut it loose it may be found again later.
+  void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   std::vector<bool> RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const;
   // The joint pose + displacement problem; fills displacements and inlier flags.
   void SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
                         std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
+  // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
+  // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.
+  int PropagateMotion(const std::unordered_map<PointId, Eigen::Vector3d>& optimised,
+                      const std::vector<PointId>& demoted);
+  // Drops lost points that are too old or that the graph has cut loose.
+  void ForgetLostPoints(int frame);
+  // Looks for lost points near their projection; found ones become tracks again.
+  void Reassociate(const ImagePyramid& pyramid, const cv::Mat& grey, const cv::Mat& mask, FrameResult* result);
   FrameResult Lost(FrameResult result, const std::string& why);
 };
 

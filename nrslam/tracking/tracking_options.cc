@@ -12,6 +12,8 @@ void TrackingOptions::Check() const {
               "tracking", "rounds and iterations must be >= 1");
   CheckOption(pose_sigma_px > 0 && outlier_chi2 > 0 && displacement_iqr_factor > 0, "tracking",
               "sigma, chi2 and IQR factor must be > 0");
+  CheckOption(reassociation_levels >= 1 && reassociation_gate_px2 > 0 && lost_max_age_frames >= 1,
+              "tracking", "reassociation_levels, reassociation_gate_px2 and lost_max_age_frames must be positive");
 }
 
 }  // namespace nrslam

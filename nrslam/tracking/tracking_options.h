@@ -17,10 +17,18 @@ struct TrackingOptions {
   int deformation_iterations = 10;    // ... of this many LM iterations each
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
   double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
+  // Mid-term re-association: a lost map point is looked for again by a KLT seeded at its
+  // projection, with the patch of the keyframe it was last tracked from.
+  bool reassociation = true;
+  int reassociation_levels = 2;            // pyramid levels of that KLT (the seed is close)
+  double reassociation_gate_px2 = 5.99;    // squared px between the found position and the projection
+  int lost_max_age_frames = 90;   // a point lost longer ago is neither moved nor looked for (bounds work)
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
-                                                deformation_iterations, outlier_chi2, displacement_iqr_factor)
+                                                deformation_iterations, outlier_chi2, displacement_iqr_factor,
+                                                reassociation, reassociation_levels, reassociation_gate_px2,
+                                                lost_max_age_frames)
 
 }  // namespace nrslam
