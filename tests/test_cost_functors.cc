@@ -118,7 +118,8 @@ TEST(RegularizerCosts, KnownEnergiesOfBothWeightings) {
     return SquaredResidual(*cost, {delta_i, zero});
   };
   EXPECT_NEAR(viscous_energy(paper), 0.5 * 0.01, 1e-12);                                 // b ‖δi − δj‖²
-  EXPECT_NEAR(viscous_energy(reference), std::pow(0.5 * 0.1 / (0.1 * 2.0), 2), 1e-12);   // (b Δδ / σ_v s)²
+  EXPECT_NEAR(viscous_energy(reference), std::pow(0.5 * 0.1 / (reference.viscous_sigma_factor * 2.0), 2),
+              1e-12);  // (b Δδ / σ_v s)²
 
   // Keyframe form: point i moves by 0.1 between keyframes, j stays.
   const double x_i_next[3] = {0.1, 0, 0};

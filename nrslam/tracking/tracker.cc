@@ -304,6 +304,9 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
   const PoseParams rigid = pose->ToParams();
   Se3Manifold manifold;
   inliers->assign(n, true);
+  // A viscous term whose residual ended a round beyond the Huber δ sits the next round out:
+  // neighbours that really move apart (strong or discontinuous deformation) stop pulling.
+  std::vector<bool> viscous_on(pairs.size(), true);
   PoseParams params = rigid;
   const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
   for (int round = 0; round < options_.deformation_rounds; ++round) {
@@ -322,7 +325,8 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
           (*displacements)[i].data());
       problem.SetParameterBlockConstant(points[i].data());
     }
-    for (const Pair& pair : pairs) {
+    for (size_t p = 0; p < pairs.size(); ++p) {
+      const Pair& pair = pairs[p];
       double* delta_i = (*displacements)[pair.i].data();
       double* delta_j = (*displacements)[pair.j].data();
       problem.AddResidualBlock(
@@ -330,7 +334,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
                               ElasticMultiplier(deformation_, pair.rest_length)),
           new ceres::HuberLoss(deformation_.huber_deformation), delta_i, delta_j);
       // An outlier's motion is not evidence for its neighbours': its viscous terms go too.
-      if ((*inliers)[pair.i] && (*inliers)[pair.j]) {
+      if ((*inliers)[pair.i] && (*inliers)[pair.j] && viscous_on[p]) {
         problem.AddResidualBlock(ViscousCost::Create(ViscousMultiplier(deformation_, pair.weight, map_->scale())),
                                  new ceres::HuberLoss(deformation_.huber_deformation), delta_i, delta_j);
       }
@@ -342,6 +346,12 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
       (*inliers)[i] = SquaredReprojection(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
                           sigma2 <=
                       options_.outlier_chi2;
+    }
+    const double viscous_chi2 = deformation_.huber_deformation * deformation_.huber_deformation;
+    for (size_t p = 0; p < pairs.size(); ++p) {
+      const Pair& pair = pairs[p];
+      const double multiplier = ViscousMultiplier(deformation_, pair.weight, map_->scale());
+      viscous_on[p] = (multiplier * ((*displacements)[pair.i] - (*displacements)[pair.j])).squaredNorm() <= viscous_chi2;
     }
   }
   *pose = Rigid3::FromParams(params.data());
