@@ -1,0 +1,164 @@
+#include "nrslam/batch/manifest.h"
+
+#include <algorithm>
+#include <fstream>
+#include <set>
+
+#include "nrslam/sim/sim_options.h"
+#include "nrslam/system/system_options.h"
+
+namespace nrslam {
+
+std::string ResolveRunOption(const std::string& name) {
+  static const std::vector<std::string> paths = LeafPaths(Json(SystemOptions{}));
+  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
+  std::vector<std::string> matches;
+  for (const std::string& path : paths) {
+    const size_t dot = path.rfind('.');
+    if (path.substr(dot == std::string::npos ? 0 : dot + 1) == name) matches.push_back(path);
+  }
+  if (matches.size() == 1) return matches.front();
+  std::string known;
+  for (const std::string& path : matches.empty() ? paths : matches) known += (known.empty() ? "" : ", ") + path;
+  throw Error("option '" + name + "' is " + (matches.empty() ? "unknown; options are: " : "ambiguous: ") + known);
+}
+
+std::string Assignment(const std::string& path, const Json& value) {
+  return path + "=" + (value.is_string() ? value.get<std::string>() : value.dump());
+}
+
+namespace {
+
+// The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).
+const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "simulate", "set", "init",
+                                             "rigid", "first_frame", "last_frame"};
+
+void Require(bool condition, const std::string& context, const std::string& message) {
+  if (!condition) throw Error(context + ": " + message);
+}
+
+// Merges the defaults under an entry: objects ("set", "simulate") key by key, the rest whole.
+Json WithDefaults(const Json& defaults, const Json& entry) {
+  Json merged = defaults;
+  for (const auto& [key, value] : entry.items()) {
+    if (value.is_object() && merged.contains(key) && merged[key].is_object()) {
+      merged[key].update(value);
+    } else {
+      merged[key] = value;
+    }
+  }
+  // Default simulator options concern the presets only.
+  if (merged.contains("path") && !entry.contains("simulate")) merged.erase("simulate");
+  return merged;
+}
+
+ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& folder, const std::string& context) {
+  Require(entry.is_object(), context, "each sequence must be a JSON object");
+  for (const auto& [key, value] : entry.items()) {
+    Require(kSequenceKeys.count(key) > 0, context, "unknown key '" + key + "'");
+  }
+  ManifestSequence sequence;
+  Require(entry.contains("name") && entry["name"].is_string() && !entry["name"].get<std::string>().empty(), context,
+          "needs a \"name\"");
+  sequence.name = entry["name"];
+  Require(sequence.name.find_first_of("/\\ ") == std::string::npos && sequence.name != "." && sequence.name != "..",
+          context, "name '" + sequence.name + "' must not contain '/', '\\' or spaces");
+  const bool has_path = entry.contains("path"), has_preset = entry.contains("preset");
+  Require(has_path != has_preset, context, "needs exactly one of \"path\" (a sequence folder) or \"preset\"");
+  if (has_path) {
+    Require(entry["path"].is_string(), context, "\"path\" must be a string");
+    sequence.path = std::filesystem::path(entry["path"].get<std::string>());
+    if (sequence.path.is_relative()) sequence.path = folder / sequence.path;
+    sequence.path = sequence.path.lexically_normal();
+    Require(!entry.contains("simulate"), context, "\"simulate\" only applies to a preset");
+  } else {
+    Require(entry["preset"].is_string(), context, "\"preset\" must be a string");
+    sequence.preset = entry["preset"];
+    SimOptions sim;
+    try {
+      sim = SimPreset(sequence.preset);
+    } catch (const Error& e) {
+      throw Error(context + ": " + e.what());
+    }
+    if (entry.contains("simulate")) {
+      Require(entry["simulate"].is_object(), context, "\"simulate\" must be an object of simulator options");
+      for (const auto& [key, value] : entry["simulate"].items()) sequence.simulate.push_back(Assignment(key, value));
+      std::sort(sequence.simulate.begin(), sequence.simulate.end());
+      try {
+        WithAssignments(sim, sequence.simulate);
+      } catch (const Error& e) {
+        throw Error(context + ": simulate: " + e.what());
+      }
+    }
+  }
+  if (entry.contains("set")) {
+    Require(entry["set"].is_object(), context, "\"set\" must be an object of run options");
+    for (const auto& [key, value] : entry["set"].items()) {
+      try {
+        sequence.assignments.push_back(Assignment(ResolveRunOption(key), value));
+      } catch (const Error& e) {
+        throw Error(context + ": set: " + e.what());
+      }
+    }
+  }
+  if (entry.contains("init")) sequence.assignments.push_back(Assignment("run.init", entry["init"]));
+  if (entry.contains("first_frame")) sequence.assignments.push_back(Assignment("run.first_frame", entry["first_frame"]));
+  if (entry.contains("last_frame")) sequence.assignments.push_back(Assignment("run.last_frame", entry["last_frame"]));
+  if (entry.contains("rigid")) {
+    Require(entry["rigid"].is_boolean(), context, "\"rigid\" must be true or false");
+    sequence.rigid = entry["rigid"];
+  }
+  try {
+    SystemOptions options;
+    options.tracking.rigid = sequence.rigid;
+    WithAssignments(options, sequence.assignments);
+  } catch (const Error& e) {
+    throw Error(context + ": " + e.what());
+  }
+  return sequence;
+}
+
+}  // namespace
+
+Manifest LoadManifest(const std::filesystem::path& file) {
+  const std::string where = "manifest " + file.string();
+  std::ifstream stream(file);
+  if (!stream) throw Error(where + ": cannot open the file");
+  Json json;
+  try {
+    json = Json::parse(stream);
+  } catch (const Json::exception& e) {
+    throw Error(where + ": not valid JSON (" + e.what() + ")");
+  }
+  Require(json.is_object(), where, "must be a JSON object with a \"sequences\" list");
+  for (const auto& [key, value] : json.items()) {
+    Require(key == "description" || key == "defaults" || key == "sequences", where,
+            "unknown key '" + key + "' (allowed: description, defaults, sequences)");
+  }
+  Require(json.contains("sequences") && json["sequences"].is_array() && !json["sequences"].empty(), where,
+          "needs a non-empty \"sequences\" list");
+  Manifest manifest;
+  manifest.file = std::filesystem::absolute(file);
+  manifest.description = json.value("description", "");
+  const Json defaults = json.value("defaults", Json::object());
+  Require(defaults.is_object(), where, "\"defaults\" must be an object");
+  for (const char* key : {"name", "path", "preset"}) {
+    Require(!defaults.contains(key), where, std::string("\"defaults\" cannot hold \"") + key + "\"");
+  }
+  std::set<std::string> names;
+  const auto& entries = json["sequences"];
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const std::string context = where + ", sequence " + std::to_string(i + 1) +
+                                (entries[i].is_object() && entries[i].contains("name") && entries[i]["name"].is_string()
+                                     ? " ('" + entries[i]["name"].get<std::string>() + "')"
+                                     : "");
+    Require(entries[i].is_object(), context, "each sequence must be a JSON object");
+    ManifestSequence sequence =
+        ParseSequence(WithDefaults(defaults, entries[i]), manifest.file.parent_path(), context);
+    Require(names.insert(sequence.name).second, context, "the name '" + sequence.name + "' is used twice");
+    manifest.sequences.push_back(std::move(sequence));
+  }
+  return manifest;
+}
+
+}  // namespace nrslam

@@ -1,0 +1,52 @@
+// batch: the manifest, a JSON list of sequences to evaluate.
+//
+//   {
+//     "description": "what this list is for",
+//     "defaults": { "set": {"deformation.k": 1.1}, "simulate": {"frames": 60} },
+//     "sequences": [
+//       {"name": "sim-3", "preset": "sim-3", "simulate": {"camera.width": 320, "camera.height": 240}},
+//       {"name": "mine", "path": "../data/mine", "first_frame": 10, "last_frame": 200, "rigid": true}
+//     ]
+//   }
+//
+// A sequence is a folder in the sequence format (`path`, relative to the manifest) or a
+// simulator preset (`preset`, with `simulate` options by their nrslam_simulate --set paths),
+// rendered on demand into a cache. Per sequence and in `defaults`: `set` (run options by
+// their nrslam_run --set path, or by a unique last name such as "k"), `init`, `rigid`,
+// `first_frame`, `last_frame`. Everything is validated when the manifest is loaded.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+struct ManifestSequence {
+  std::string name;                       // unique within the manifest; names the run folder
+  std::filesystem::path path;             // a sequence folder (absolute), or empty for a preset
+  std::string preset;                     // simulator preset, or empty for a folder
+  std::vector<std::string> simulate;      // simulator assignments "path=value", sorted
+  std::vector<std::string> assignments;   // run assignments "module.option=value"
+  bool rigid = false;
+};
+
+struct Manifest {
+  std::filesystem::path file;
+  std::string description;
+  std::vector<ManifestSequence> sequences;
+};
+
+// Throws Error naming the manifest, the sequence and what is wrong.
+Manifest LoadManifest(const std::filesystem::path& file);
+
+// A run option's full path from a full path or a unique last name ("k" → "deformation.k");
+// throws Error listing the candidates when unknown or ambiguous.
+std::string ResolveRunOption(const std::string& name);
+
+// "path=value" for a JSON value (strings unquoted).
+std::string Assignment(const std::string& path, const Json& value);
+
+}  // namespace nrslam

@@ -1,0 +1,235 @@
+#include "nrslam/batch/results.h"
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "nrslam/util/text_table.h"
+
+namespace nrslam {
+namespace {
+
+std::string Key(const RunResult& result) {
+  return result.label.empty() ? result.sequence : result.sequence + " [" + result.label + "]";
+}
+
+Json ReadJson(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  if (!stream) throw Error("cannot open " + file.string());
+  try {
+    return Json::parse(stream);
+  } catch (const Json::exception& e) {
+    throw Error(file.string() + " is not valid JSON (" + e.what() + ")");
+  }
+}
+
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+}  // namespace
+
+std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
+  std::vector<RunResult> results;
+  for (const RunJob& run : plan.runs) {
+    RunResult result;
+    result.sequence = run.sequence;
+    result.label = run.label;
+    result.point = run.point;
+    result.run_folder = run.run_folder.string();
+    try {
+      if (std::filesystem::exists(run.run_folder / "summary.json")) {
+        const Json summary = ReadJson(run.run_folder / "summary.json");
+        result.init_frame = summary.value("init_frame", -1);
+        result.frames_tracked = summary.value("frames_tracked", 0);
+        result.frames_total = summary.value("frames_total", 0);
+        result.rmse_mm = summary.value("rmse_mm", 0.0);
+        result.rmse_median_mm = summary.value("rmse_median_mm", 0.0);
+        result.fps = summary.value("fps", 0.0);
+        result.status = result.frames_tracked + std::max(result.init_frame, 0) >= result.frames_total ? "ok" : "lost";
+      } else if (std::filesystem::exists(run.run_folder / "failure.json")) {
+        result.error = ReadJson(run.run_folder / "failure.json").value("error", "unknown failure");
+      } else {
+        result.error = "not run";
+      }
+    } catch (const Error& e) {
+      result.error = e.what();
+    }
+    results.push_back(result);
+  }
+  return results;
+}
+
+Json ToJson(const std::vector<RunResult>& results) {
+  Json rows = Json::array();
+  for (const RunResult& r : results) {
+    rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
+                    {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
+                    {"frames_total", r.frames_total}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
+                    {"fps", r.fps}, {"run_folder", r.run_folder}});
+  }
+  return {{"results", rows}};
+}
+
+std::vector<RunResult> ResultsFromJson(const Json& json) {
+  std::vector<RunResult> results;
+  try {
+    for (const Json& row : json.at("results")) {
+      RunResult r;
+      r.sequence = row.at("sequence");
+      r.label = row.value("label", "");
+      r.point = row.value("point", std::vector<std::string>{});
+      r.status = row.at("status");
+      r.error = row.value("error", "");
+      r.init_frame = row.value("init_frame", -1);
+      r.frames_tracked = row.value("frames_tracked", 0);
+      r.frames_total = row.value("frames_total", 0);
+      r.rmse_mm = row.value("rmse_mm", 0.0);
+      r.rmse_median_mm = row.value("rmse_median_mm", 0.0);
+      r.fps = row.value("fps", 0.0);
+      r.run_folder = row.value("run_folder", "");
+      results.push_back(r);
+    }
+  } catch (const Json::exception& e) {
+    throw Error(std::string("results are malformed: ") + e.what());
+  }
+  return results;
+}
+
+void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
+  std::ofstream csv(folder / "results.csv");
+  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,rmse_mm,rmse_median_mm,fps,error\n";
+  for (const RunResult& r : results) {
+    csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',' << r.fps
+        << ',' << CsvField(r.error) << '\n';
+  }
+}
+
+std::vector<RunResult> ReadResults(const std::filesystem::path& folder) {
+  return ResultsFromJson(ReadJson(folder / "results.json"));
+}
+
+void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
+  bool swept = false;
+  for (const RunResult& r : results) swept |= !r.label.empty();
+  std::vector<std::string> header = {"sequence"};
+  if (swept) header.push_back("sweep point");
+  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "fps"}) header.push_back(column);
+  TextTable table(header);
+  for (const RunResult& r : results) {
+    std::vector<std::string> row = {r.sequence};
+    if (swept) row.push_back(r.label);
+    if (r.status == "failed") {
+      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-"}) row.push_back(cell);
+    } else {
+      row.insert(row.end(), {r.status, std::to_string(r.init_frame),
+                             std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
+                             FormatFixed(r.rmse_mm, 3), FormatFixed(r.rmse_median_mm, 3), FormatFixed(r.fps, 1)});
+    }
+    table.AddRow(row);
+  }
+  table.Print(out);
+  for (const RunResult& r : results) {
+    if (r.status == "failed") out << "FAILED " << Key(r) << ": " << r.error << '\n';
+  }
+  if (!swept) return;
+  // Per swept option and value: mean RMSE over the sequences that tracked every frame at
+  // every point of the sweep, so each value is averaged over the same sequences.
+  std::map<std::string, bool> complete;  // sequence -> ok at every point
+  for (const RunResult& r : results) {
+    const bool ok = r.status == "ok";
+    complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
+  }
+  std::map<std::string, std::map<std::string, std::pair<double, int>>> by_value;  // option -> value -> (sum, n)
+  for (const RunResult& r : results) {
+    if (!complete[r.sequence]) continue;
+    for (const std::string& assignment : r.point) {
+      const size_t equals = assignment.find('=');
+      auto& cell = by_value[assignment.substr(0, equals)][assignment.substr(equals + 1)];
+      cell.first += r.rmse_mm;
+      cell.second += 1;
+    }
+  }
+  int sequences = 0;
+  for (const auto& [name, ok] : complete) sequences += ok;
+  out << "\nMean RMSE per swept value, over the " << sequences << " sequence(s) tracked to the end at every point:\n";
+  TextTable summary({"option", "value", "mean RMSE mm", "runs"});
+  for (const auto& [option, values] : by_value) {
+    for (const auto& [value, cell] : values) {
+      summary.AddRow({option, value, FormatFixed(cell.first / cell.second, 3), std::to_string(cell.second)});
+    }
+  }
+  summary.Print(out);
+}
+
+Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance& tolerance) {
+  Json runs = Json::object();
+  for (const RunResult& r : results) {
+    if (r.status == "failed") continue;
+    runs[Key(r)] = {{"rmse_mm", r.rmse_mm}, {"frames_tracked", r.frames_tracked}};
+  }
+  return {{"tolerance",
+           {{"rmse_relative", tolerance.rmse_relative},
+            {"rmse_absolute_mm", tolerance.rmse_absolute_mm},
+            {"frames_tracked", tolerance.frames_tracked}}},
+          {"runs", runs}};
+}
+
+BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline) {
+  BaselineTolerance tolerance;
+  Json runs;
+  try {
+    const Json& given = baseline.at("tolerance");
+    tolerance.rmse_relative = given.at("rmse_relative");
+    tolerance.rmse_absolute_mm = given.at("rmse_absolute_mm");
+    tolerance.frames_tracked = given.at("frames_tracked");
+    runs = baseline.at("runs");
+  } catch (const Json::exception& e) {
+    throw Error(std::string("baseline is malformed (needs \"tolerance\" and \"runs\"): ") + e.what());
+  }
+  std::map<std::string, const RunResult*> by_key;
+  for (const RunResult& r : results) by_key[Key(r)] = &r;
+  BaselineCheck check;
+  TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
+  for (const auto& [key, expected] : runs.items()) {
+    const double rmse_before = expected.at("rmse_mm");
+    const int tracked_before = expected.at("frames_tracked");
+    const double allowed = rmse_before * (1.0 + tolerance.rmse_relative) + tolerance.rmse_absolute_mm;
+    const auto found = by_key.find(key);
+    std::string verdict = "ok";
+    std::vector<std::string> row = {key, FormatFixed(rmse_before, 3)};
+    if (found == by_key.end() || found->second->status == "failed") {
+      verdict = found == by_key.end() ? "MISSING" : "FAILED: " + found->second->error;
+      row.insert(row.end(), {"-", FormatFixed(allowed, 3), std::to_string(tracked_before), "-"});
+    } else {
+      const RunResult& now = *found->second;
+      if (now.frames_tracked < tracked_before - tolerance.frames_tracked) {
+        verdict = "WORSE: fewer frames tracked";
+      } else if (now.rmse_mm > allowed) {
+        verdict = "WORSE: RMSE +" + FormatFixed(100.0 * (now.rmse_mm / rmse_before - 1.0), 1) + " %";
+      } else if (now.rmse_mm < rmse_before * (1.0 - tolerance.rmse_relative) - tolerance.rmse_absolute_mm) {
+        verdict = "better (consider updating the baseline)";
+      }
+      row.insert(row.end(), {FormatFixed(now.rmse_mm, 3), FormatFixed(allowed, 3), std::to_string(tracked_before),
+                             std::to_string(now.frames_tracked)});
+    }
+    check.passed &= verdict.rfind("ok", 0) == 0 || verdict.rfind("better", 0) == 0;
+    row.push_back(verdict);
+    table.AddRow(row);
+  }
+  std::ostringstream report;
+  report << "Baseline check (RMSE may grow by " << FormatFixed(100 * tolerance.rmse_relative, 0) << " % + "
+         << tolerance.rmse_absolute_mm << " mm; frames tracked may drop by " << tolerance.frames_tracked << "):\n";
+  table.Print(report);
+  report << (check.passed ? "PASSED" : "FAILED: at least one run is worse than the baseline allows") << '\n';
+  check.report = report.str();
+  return check;
+}
+
+}  // namespace nrslam

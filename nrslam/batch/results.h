@@ -1,0 +1,58 @@
+// batch: the results of an evaluation — one row per run, read back from the run folders —
+// as a table, results.json / results.csv, and the regression baseline check.
+#pragma once
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+struct RunResult {
+  std::string sequence;
+  std::string label;                // sweep point, "" without sweeps
+  std::vector<std::string> point;   // "path=value" per swept option
+  std::string status = "failed";    // "ok", "lost" (tracking lost before the end) or "failed"
+  std::string error;                // why it failed
+  int init_frame = -1, frames_tracked = 0, frames_total = 0;
+  double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
+  std::string run_folder;
+};
+
+// Reads each run's summary.json (or failure.json) from its folder.
+std::vector<RunResult> CollectResults(const EvaluationPlan& plan);
+
+Json ToJson(const std::vector<RunResult>& results);
+std::vector<RunResult> ResultsFromJson(const Json& json);
+
+// results.json and results.csv in `folder`.
+void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder);
+// Reads a folder's results.json; throws Error if it has none.
+std::vector<RunResult> ReadResults(const std::filesystem::path& folder);
+
+// The table a person reads: sequence, [sweep point], status, init frame, tracked/total,
+// RMSE mean and median (mm), fps. With sweeps, also the mean RMSE per value of each option
+// over the sequences tracked at every point.
+void PrintResults(const std::vector<RunResult>& results, std::ostream& out);
+
+// A regression baseline: per run key (sequence [label]), RMSE and frames tracked, plus the
+// tolerance a later result is allowed.
+struct BaselineTolerance {
+  double rmse_relative = 0.10;    // RMSE may grow by this fraction ...
+  double rmse_absolute_mm = 0.02; // ... plus this much (noise floor on near-zero RMSE)
+  int frames_tracked = 0;         // frames tracked may drop by this many
+};
+Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance& tolerance);
+
+struct BaselineCheck {
+  bool passed = true;
+  std::string report;  // a table of every baselined run: before, now, verdict
+};
+// Fails on a run that is worse than tolerated, failed, or missing from the results.
+BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline);
+
+}  // namespace nrslam

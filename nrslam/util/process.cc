@@ -1,0 +1,105 @@
+#include "nrslam/util/process.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cerrno>
+#include <cstring>
+#include <map>
+
+extern char** environ;
+
+namespace nrslam {
+
+std::string ProcessOutcome::Describe() const {
+  if (!error.empty()) return error;
+  if (signal != 0) return "killed by signal " + std::to_string(signal) + " (" + strsignal(signal) + ")";
+  return "exit code " + std::to_string(exit_code);
+}
+
+namespace {
+
+// Starts one child with its output in `command.log`; returns its pid, or -1 with `error` set.
+pid_t Start(const Command& command, std::string* error) {
+  if (command.argv.empty()) {
+    *error = "empty command";
+    return -1;
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  const std::string log = command.log.string();
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  std::vector<char*> argv;
+  for (const std::string& argument : command.argv) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int status = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (status != 0) {
+    *error = "cannot start " + command.argv[0] + ": " + std::strerror(status);
+    return -1;
+  }
+  return pid;
+}
+
+}  // namespace
+
+std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
+                                        const std::function<void(size_t, const ProcessOutcome&)>& done) {
+  std::vector<ProcessOutcome> outcomes(commands.size());
+  std::map<pid_t, size_t> running;
+  size_t next = 0;
+  const size_t limit = static_cast<size_t>(std::max(1, jobs));
+  while (next < commands.size() || !running.empty()) {
+    while (next < commands.size() && running.size() < limit) {
+      const pid_t pid = Start(commands[next], &outcomes[next].error);
+      if (pid < 0) {
+        if (done) done(next, outcomes[next]);
+      } else {
+        running[pid] = next;
+      }
+      ++next;
+    }
+    if (running.empty()) continue;
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      // No children left to wait for although we think some run: record and stop waiting.
+      for (const auto& [lost_pid, index] : running) outcomes[index].error = "lost track of the child process";
+      running.clear();
+      continue;
+    }
+    const auto found = running.find(pid);
+    if (found == running.end()) continue;
+    ProcessOutcome& outcome = outcomes[found->second];
+    if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
+    if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
+    const size_t index = found->second;
+    running.erase(found);
+    if (done) done(index, outcome);
+  }
+  return outcomes;
+}
+
+std::string ShellLine(const std::vector<std::string>& argv) {
+  std::string line;
+  for (const std::string& argument : argv) {
+    if (!line.empty()) line += ' ';
+    const bool plain = !argument.empty() && argument.find_first_not_of(
+        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=,:+@%") == std::string::npos;
+    if (plain) {
+      line += argument;
+      continue;
+    }
+    line += '\'';
+    for (char c : argument) line += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    line += '\'';
+  }
+  return line;
+}
+
+}  // namespace nrslam

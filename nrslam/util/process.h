@@ -1,0 +1,37 @@
+// util: running other programs as child processes, a few at a time.
+//
+// The batch evaluator runs every sequence in its own process so that one sequence that
+// crashes or runs out of memory cannot take the others down, and so that runs on many
+// cores share nothing.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace nrslam {
+
+struct Command {
+  std::vector<std::string> argv;  // argv[0] is the program's path
+  std::filesystem::path log;      // receives the child's stdout and stderr (truncated first)
+};
+
+struct ProcessOutcome {
+  int exit_code = -1;  // when the child exited
+  int signal = 0;      // when a signal ended it
+  std::string error;   // when it could not be started
+  bool ok() const { return error.empty() && signal == 0 && exit_code == 0; }
+  // "exit code 1", "killed by signal 11 (Segmentation fault)", or the start error.
+  std::string Describe() const;
+};
+
+// Runs the commands, at most `jobs` at once, in order of index; `done` is called (on this
+// thread) as each one finishes. Never throws for a child's failure: that is its outcome.
+std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
+                                        const std::function<void(size_t index, const ProcessOutcome&)>& done = {});
+
+// A command as one line a POSIX shell runs as is (every argument single-quoted as needed).
+std::string ShellLine(const std::vector<std::string>& argv);
+
+}  // namespace nrslam

@@ -1,0 +1,217 @@
+// Batch evaluation: manifests and their validation, a batch that survives a broken sequence,
+// resumed sweeps, the baseline check, and jobs emitted for GNU parallel then merged.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/manifest.h"
+#include "nrslam/batch/results.h"
+#include "temp_folder.h"
+
+namespace nrslam {
+namespace {
+
+const Programs kPrograms{NRSLAM_TOOLS_DIR "/nrslam_simulate", NRSLAM_TOOLS_DIR "/nrslam_run"};
+
+std::filesystem::path WriteFile(const std::filesystem::path& file, const std::string& text) {
+  std::filesystem::create_directories(file.parent_path());
+  std::ofstream(file) << text;
+  return file;
+}
+
+std::string ErrorOf(const std::filesystem::path& manifest) {
+  try {
+    LoadManifest(manifest);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A tiny simulated sequence: enough frames and points to track, quick to render and run.
+constexpr const char* kTinySimulate = R"({"frames": 8, "camera.width": 320, "camera.height": 240})";
+
+TEST(Manifest, EachMistakeIsNamed) {
+  const auto folder = UniqueTempFolder("manifest_errors");
+  auto manifest = [&](const std::string& sequences) {
+    return WriteFile(folder / "m.json", R"({"sequences": [)" + sequences + "]}");
+  };
+  EXPECT_NE(ErrorOf(folder / "absent.json").find("cannot open"), std::string::npos);
+  EXPECT_NE(ErrorOf(WriteFile(folder / "bad.json", "{ not json")).find("not valid JSON"), std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0", "colour": 1})")).find("unknown key 'colour'"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0", "path": "x"})")).find("exactly one of"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-9"})")).find("sim-9"), std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0", "set": {"stiffness": 2}})")).find("'stiffness' is unknown"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0", "simulate": {"frames": "many"}})")).find("simulate"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0"}, {"name": "a", "preset": "sim-1"})")).find("used twice"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0", "set": {"k": -1}})")).find("sequence 1 ('a')"),
+            std::string::npos);
+  std::filesystem::remove_all(folder);
+}
+
+TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
+  const auto folder = UniqueTempFolder("manifest_ok");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "lists" / "m.json", R"({
+    "defaults": {"set": {"k": 2, "max_degree_D": 4}, "simulate": {"frames": 9}},
+    "sequences": [
+      {"name": "s", "preset": "sim-1", "set": {"max_degree_D": 6}},
+      {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3}
+    ]})"));
+  ASSERT_EQ(manifest.sequences.size(), 2u);
+  const ManifestSequence& s = manifest.sequences[0];
+  EXPECT_EQ(s.simulate, std::vector<std::string>{"frames=9"});
+  EXPECT_EQ(s.assignments, (std::vector<std::string>{"deformation.k=2", "deformation.max_degree_D=6"}));
+  const ManifestSequence& f = manifest.sequences[1];
+  EXPECT_TRUE(f.simulate.empty());  // simulator defaults concern presets only
+  EXPECT_EQ(f.path, (std::filesystem::absolute(folder) / "data" / "f").lexically_normal());
+  EXPECT_TRUE(f.rigid);
+  EXPECT_NE(std::find(f.assignments.begin(), f.assignments.end(), "run.first_frame=3"), f.assignments.end());
+  std::filesystem::remove_all(folder);
+}
+
+TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
+  const auto folder = UniqueTempFolder("sweep_plan");
+  const Manifest manifest =
+      LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [{"name": "s", "preset": "sim-0"}, {"name": "t", "preset": "sim-0"}]})"));
+  const EvaluationPlan plan =
+      PlanEvaluation(manifest, {}, {ParseSweep("k=0.5,2"), ParseSweep("max_degree_D=3,5,10")}, folder / "out", folder / "cache");
+  EXPECT_EQ(plan.renders.size(), 1u);  // both sequences are the same render
+  ASSERT_EQ(plan.runs.size(), 12u);
+  EXPECT_EQ(plan.runs[0].label, "k=0.5,max_degree_D=3");
+  EXPECT_EQ(plan.runs[5].label, "k=2,max_degree_D=10");
+  EXPECT_EQ(plan.runs[5].run_folder, std::filesystem::absolute(folder / "out" / "runs" / "s" / "k=2,max_degree_D=10"));
+  EXPECT_THROW(ParseSweep("k"), Error);
+  EXPECT_THROW(ParseSweep("nonsense=1,2"), Error);
+  // A value the option cannot take is caught before anything runs.
+  EXPECT_THROW(PlanEvaluation(manifest, {}, {ParseSweep("k=-1")}, folder / "out", folder / "cache"), Error);
+  std::filesystem::remove_all(folder);
+}
+
+RunResult Result(const std::string& sequence, double rmse, int tracked) {
+  RunResult r;
+  r.sequence = sequence;
+  r.status = "ok";
+  r.rmse_mm = rmse;
+  r.frames_tracked = tracked;
+  r.frames_total = 60;
+  r.init_frame = 0;
+  return r;
+}
+
+TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
+  const std::vector<RunResult> before = {Result("a", 1.0, 60), Result("b", 0.10, 60)};
+  const Json baseline = MakeBaseline(before, BaselineTolerance{});  // 10 % + 0.02 mm
+  EXPECT_TRUE(CheckBaseline(before, baseline).passed);
+  // Within the tolerance: 1.0 → 1.11 (allowed 1.12), and an improvement.
+  EXPECT_TRUE(CheckBaseline({Result("a", 1.11, 60), Result("b", 0.05, 60)}, baseline).passed);
+  const BaselineCheck worse = CheckBaseline({Result("a", 1.13, 60), Result("b", 0.10, 60)}, baseline);
+  EXPECT_FALSE(worse.passed);
+  EXPECT_NE(worse.report.find("WORSE: RMSE +13.0 %"), std::string::npos) << worse.report;
+  EXPECT_FALSE(CheckBaseline({Result("a", 1.0, 59), Result("b", 0.10, 60)}, baseline).passed);
+  EXPECT_FALSE(CheckBaseline({Result("a", 1.0, 60)}, baseline).passed);  // b missing
+  RunResult failed = Result("b", 0, 0);
+  failed.status = "failed";
+  failed.error = "boom";
+  const BaselineCheck crash = CheckBaseline({Result("a", 1.0, 60), failed}, baseline);
+  EXPECT_FALSE(crash.passed);
+  EXPECT_NE(crash.report.find("FAILED: boom"), std::string::npos);
+}
+
+TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
+  const auto folder = UniqueTempFolder("batch_broken");
+  // A sequence folder with an incomplete sequence.json, between two good simulated ones.
+  WriteFile(folder / "broken" / "sequence.json", R"({"format": "nrslam-sequence"})");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({
+    "defaults": {"simulate": )") + kTinySimulate + R"(},
+    "sequences": [
+      {"name": "good", "preset": "sim-1"},
+      {"name": "broken", "path": "broken"},
+      {"name": "good-rigid", "preset": "sim-1", "rigid": true}
+    ]})"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  std::vector<std::string> lines;
+  ExecutePlan(plan, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
+  const std::vector<RunResult> results = CollectResults(plan);
+  ASSERT_EQ(results.size(), 3u);
+  EXPECT_EQ(results[0].status, "ok") << results[0].error;
+  EXPECT_EQ(results[0].frames_tracked, 8);
+  EXPECT_GT(results[0].rmse_mm, 0.0);
+  EXPECT_EQ(results[1].status, "failed");
+  EXPECT_NE(results[1].error.find("exit code 1"), std::string::npos) << results[1].error;
+  EXPECT_NE(results[1].error.find("missing field 'camera'"), std::string::npos) << results[1].error;  // the reader's message
+  EXPECT_NE(results[2].status, "failed") << results[2].error;
+  std::stringstream table;
+  PrintResults(results, table);
+  EXPECT_NE(table.str().find("FAILED broken:"), std::string::npos) << table.str();
+  WriteResults(results, folder / "out");
+  const std::vector<RunResult> read = ReadResults(folder / "out");
+  ASSERT_EQ(read.size(), 3u);
+  EXPECT_EQ(read[1].error, results[1].error);
+  EXPECT_DOUBLE_EQ(read[0].rmse_mm, results[0].rmse_mm);
+  std::filesystem::remove_all(folder);
+}
+
+TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
+  const auto folder = UniqueTempFolder("batch_resume");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({
+    "sequences": [{"name": "s", "preset": "sim-1", "simulate": )") + kTinySimulate + "}]}"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {ParseSweep("max_degree_D=4,8")}, folder / "out", folder / "cache");
+  ASSERT_EQ(plan.runs.size(), 2u);
+  ExecutePlan(plan, kPrograms, 2, [](const std::string&) {});
+  const std::vector<RunResult> first = CollectResults(plan);
+  ASSERT_EQ(first[0].status, "ok") << first[0].error;
+  ASSERT_EQ(first[1].status, "ok") << first[1].error;
+  // As if the second run had been interrupted: only it runs again.
+  std::filesystem::remove(plan.runs[1].run_folder / "summary.json");
+  const auto untouched = std::filesystem::last_write_time(plan.runs[0].run_folder / "summary.json");
+  std::vector<std::string> lines;
+  ExecutePlan(plan, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "1 run(s) already finished, not run again");
+  EXPECT_NE(lines[1].find("[1/1] s [max_degree_D=8] done"), std::string::npos) << lines[1];
+  EXPECT_EQ(std::filesystem::last_write_time(plan.runs[0].run_folder / "summary.json"), untouched);
+  const std::vector<RunResult> second = CollectResults(plan);
+  EXPECT_DOUBLE_EQ(second[1].rmse_mm, first[1].rmse_mm);  // the same run, the same answer
+  std::filesystem::remove_all(folder);
+}
+
+TEST(BatchEvaluation, EmittedJobsRunByGnuParallelThenMerged) {
+  if (std::system("parallel --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "GNU parallel is not installed";
+  const auto folder = UniqueTempFolder("batch_parallel");
+  const std::filesystem::path manifest = WriteFile(folder / "m.json", std::string(R"({
+    "defaults": {"simulate": )") + kTinySimulate + R"(},
+    "sequences": [{"name": "a", "preset": "sim-1"}, {"name": "b", "preset": "sim-1", "rigid": true}]})");
+  const std::string eval = std::string(NRSLAM_TOOLS_DIR) + "/nrslam_eval";
+  const std::string common = " --out " + (folder / "out").string() + " --cache " + (folder / "cache").string() +
+                             " --sweep max_degree_D=4,8";
+  ASSERT_EQ(std::system((eval + " " + manifest.string() + common + " --emit-jobs " + (folder / "jobs.txt").string() +
+                         " > /dev/null").c_str()),
+            0);
+  std::ifstream jobs(folder / "jobs.txt");
+  const std::string text((std::istreambuf_iterator<char>(jobs)), {});
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
+  // Four jobs, two at a time; both renders of the one preset race for the same cache folder.
+  ASSERT_EQ(std::system(("parallel --will-cite -j2 < " + (folder / "jobs.txt").string() + " > /dev/null 2>&1").c_str()), 0);
+  ASSERT_EQ(std::system((eval + " merge " + manifest.string() + common + " > " + (folder / "merge.txt").string()).c_str()), 0);
+  const std::vector<RunResult> merged = ReadResults(folder / "out");
+  ASSERT_EQ(merged.size(), 4u);
+  for (const RunResult& r : merged) EXPECT_NE(r.status, "failed") << r.sequence << " " << r.label << ": " << r.error;
+  // Nothing half-written is left in the cache.
+  int cache_entries = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder / "cache")) {
+    ++cache_entries;
+    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
+  }
+  EXPECT_EQ(cache_entries, 1);
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace nrslam

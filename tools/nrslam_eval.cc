@@ -1,0 +1,130 @@
+// nrslam_eval: runs NR-SLAM over every sequence of a manifest (each in its own process),
+// with optional parameter sweeps, prints the results table, writes results.json/.csv, and
+// checks or writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
+// result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere).
+#include <CLI/CLI.hpp>
+
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/manifest.h"
+#include "nrslam/batch/results.h"
+
+namespace {
+
+// The sibling programs, from this executable's own folder.
+nrslam::Programs SiblingPrograms() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path folder = error ? std::filesystem::path(".") : self.parent_path();
+  return {folder / "nrslam_simulate", folder / "nrslam_run"};
+}
+
+nrslam::Json ReadJsonFile(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  if (!stream) throw nrslam::Error("cannot open " + file.string());
+  try {
+    return nrslam::Json::parse(stream);
+  } catch (const nrslam::Json::exception& e) {
+    throw nrslam::Error(file.string() + " is not valid JSON (" + e.what() + ")");
+  }
+}
+
+// Exit codes: 0 all well, 1 bad usage or input, 2 some run failed, 3 baseline check failed.
+int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem::path& out,
+           const std::string& check_baseline, const std::string& write_baseline, double tolerance) {
+  nrslam::WriteResults(results, out);
+  std::cout << '\n';
+  nrslam::PrintResults(results, std::cout);
+  std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string() << '\n';
+  int code = 0;
+  for (const auto& result : results) code = result.status == "failed" ? 2 : code;
+  if (!write_baseline.empty()) {
+    nrslam::BaselineTolerance given;
+    given.rmse_relative = tolerance;
+    std::ofstream(write_baseline) << nrslam::MakeBaseline(results, given).dump(2) << '\n';
+    std::cout << "baseline written: " << write_baseline << '\n';
+  }
+  if (!check_baseline.empty()) {
+    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, ReadJsonFile(check_baseline));
+    std::cout << '\n' << check.report;
+    if (!check.passed) code = 3;
+  }
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Evaluate NR-SLAM over a manifest of sequences"};
+  app.require_subcommand(0, 1);
+  std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline;
+  std::vector<std::string> assignments, sweeps;
+  int jobs = std::max(1u, std::thread::hardware_concurrency());
+  double tolerance = 0.10;
+  app.add_option("manifest", manifest_path, "manifest JSON (see data_manifests/)");
+  app.add_option("--out", out, "result folder: runs/<sequence>[/<sweep point>], results.json, results.csv")
+      ->capture_default_str();
+  app.add_option("--cache", cache, "where simulator presets are rendered, shared between evaluations")
+      ->capture_default_str();
+  app.add_option("--jobs,-j", jobs, "processes at once")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");
+  app.add_option("--sweep", sweeps, "run a grid: --sweep k=0.5,1.1,2 --sweep max_degree_D=3,5,10");
+  app.add_option("--emit-jobs", emit_jobs, "write one shell command per run to FILE (for GNU parallel, Slurm) "
+                                            "instead of running them");
+  app.add_option("--check-baseline", check_baseline, "fail (exit 3) when a run is worse than this baseline file");
+  app.add_option("--write-baseline", write_baseline, "write the results as a baseline file");
+  app.add_option("--tolerance", tolerance, "relative RMSE growth a written baseline allows")->capture_default_str();
+  CLI::App* merge = app.add_subcommand("merge", "aggregate result folders (their run folders) into --out");
+  merge->fallthrough();  // --out, --set, --sweep, --check-baseline given after "merge" too
+  std::vector<std::string> merge_folders;
+  std::string merge_manifest;
+  merge->add_option("manifest", merge_manifest, "the manifest the jobs were emitted from")->required();
+  merge->add_option("folders", merge_folders, "result folders to merge (default: --out)");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    const nrslam::Programs programs = SiblingPrograms();
+    std::vector<nrslam::Sweep> grid;
+    for (const std::string& sweep : sweeps) grid.push_back(nrslam::ParseSweep(sweep));
+    std::vector<std::string> resolved;
+    for (const std::string& assignment : assignments) {
+      const size_t equals = assignment.find('=');
+      if (equals == std::string::npos) throw nrslam::Error("--set '" + assignment + "': expected name=value");
+      resolved.push_back(nrslam::ResolveRunOption(assignment.substr(0, equals)) + assignment.substr(equals));
+    }
+    if (merge->parsed()) {
+      // Runs of the same plan executed elsewhere: gather their run folders under --out.
+      const nrslam::Manifest manifest = nrslam::LoadManifest(merge_manifest);
+      nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
+      for (nrslam::RunJob& run : plan.runs) {
+        for (const std::string& folder : merge_folders) {
+          const std::filesystem::path candidate =
+              std::filesystem::absolute(folder) / std::filesystem::relative(run.run_folder, std::filesystem::absolute(out));
+          if (std::filesystem::exists(candidate / "summary.json")) run.run_folder = candidate;
+        }
+      }
+      return Finish(nrslam::CollectResults(plan), out, check_baseline, write_baseline, tolerance);
+    }
+    if (manifest_path.empty()) throw nrslam::Error("a manifest is required (see data_manifests/)");
+    const nrslam::Manifest manifest = nrslam::LoadManifest(manifest_path);
+    const nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
+    std::filesystem::create_directories(out);
+    if (!emit_jobs.empty()) {
+      std::ofstream file(emit_jobs);
+      for (const nrslam::RunJob& run : plan.runs) file << nrslam::RunShellLine(plan, run, programs) << '\n';
+      std::cout << plan.runs.size() << " job(s) written to " << emit_jobs
+                << "; run them anywhere, then: nrslam_eval merge " << manifest_path << " --out " << out << '\n';
+      return 0;
+    }
+    std::cerr << manifest.sequences.size() << " sequence(s), " << plan.runs.size() << " run(s), " << jobs
+              << " at a time; output in " << out << '\n';
+    nrslam::ExecutePlan(plan, programs, jobs, [](const std::string& line) { std::cerr << line << '\n'; });
+    return Finish(nrslam::CollectResults(plan), out, check_baseline, write_baseline, tolerance);
+  } catch (const std::exception& e) {
+    std::cerr << "nrslam_eval: " << e.what() << '\n';
+    return 1;
+  }
+}
