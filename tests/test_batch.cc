@@ -7,6 +7,7 @@
 
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/manifest.h"
+#include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 #include "temp_folder.h"
 
@@ -155,6 +156,25 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   ASSERT_EQ(read.size(), 3u);
   EXPECT_EQ(read[1].error, results[1].error);
   EXPECT_DOUBLE_EQ(read[0].rmse_mm, results[0].rmse_mm);
+
+  // The report opens in a real (headless) browser: every image loads, the plots are drawn,
+  // and the failed sequence is shown as such.
+  WriteReport(results, folder / "out" / "report");
+  if (std::system("chromium --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "chromium is not installed";
+  const std::string dom = (folder / "dom.html").string(), log = (folder / "browser.log").string();
+  ASSERT_EQ(std::system(("timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=5000 "
+                         "--enable-logging=stderr --dump-dom file://" +
+                         (folder / "out" / "report" / "index.html").string() + " > " + dom + " 2> " + log)
+                            .c_str()),
+            0);
+  std::ifstream dom_stream(dom), log_stream(log);
+  const std::string page((std::istreambuf_iterator<char>(dom_stream)), {});
+  const std::string browser((std::istreambuf_iterator<char>(log_stream)), {});
+  // Two tracked runs: each an RMSE plot, a trajectory plot (two series) and three images.
+  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=4 series=6\""), std::string::npos)
+      << page.substr(0, 2000);
+  EXPECT_NE(page.find("Failed: exit code 1"), std::string::npos);
+  EXPECT_EQ(browser.find("Uncaught"), std::string::npos) << browser;
   std::filesystem::remove_all(folder);
 }
 

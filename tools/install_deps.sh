@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libembree-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  parallel
+  parallel chromium
 )
 
 missing=()

@@ -10,6 +10,7 @@
 
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/manifest.h"
+#include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 
 namespace {
@@ -36,9 +37,11 @@ nrslam::Json ReadJsonFile(const std::filesystem::path& file) {
 int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem::path& out,
            const std::string& check_baseline, const std::string& write_baseline, double tolerance) {
   nrslam::WriteResults(results, out);
+  nrslam::WriteReport(results, out / "report");
   std::cout << '\n';
   nrslam::PrintResults(results, std::cout);
-  std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string() << '\n';
+  std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string()
+            << "\nreport:  " << (out / "report" / "index.html").string() << '\n';
   int code = 0;
   for (const auto& result : results) code = result.status == "failed" ? 2 : code;
   if (!write_baseline.empty()) {

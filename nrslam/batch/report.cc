@@ -1,0 +1,247 @@
+#include "nrslam/batch/report.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "nrslam/batch/svg_plot.h"
+#include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/util/text_table.h"
+
+namespace nrslam {
+namespace {
+
+std::string Html(const std::string& text) {
+  std::string escaped;
+  for (char c : text) {
+    if (c == '<') escaped += "&lt;";
+    else if (c == '>') escaped += "&gt;";
+    else if (c == '&') escaped += "&amp;";
+    else if (c == '"') escaped += "&quot;";
+    else escaped += c;
+  }
+  return escaped;
+}
+
+// A file-name-safe version of a run's key.
+std::string Slug(const RunResult& result) {
+  std::string slug = result.sequence + (result.label.empty() ? "" : "__" + result.label);
+  for (char& c : slug) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  }
+  return slug;
+}
+
+// metrics.csv rows by column name (the runner's own CSV: no quoted commas but in `note`).
+std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  if (!stream) throw Error("cannot read " + file.string());
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+  std::string line;
+  while (std::getline(stream, line)) {
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    std::string field;
+    while (std::getline(split, field, ',')) fields.push_back(field);
+    if (header.empty()) {
+      header = fields;
+      continue;
+    }
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+double Number(const std::map<std::string, std::string>& row, const std::string& key) {
+  const auto found = row.find(key);
+  if (found == row.end() || found->second.empty()) return std::nan("");
+  try {
+    return std::stod(found->second);
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
+// Camera positions of a TUM file by timestamp, in the ground truth's world: the estimate's
+// world is its first camera, so it is carried over with that frame's true pose.
+struct Trajectories {
+  PlotSeries estimate{"estimate", "#d62728", {}, {}}, truth{"ground truth", "#222", {}, {}};
+};
+Trajectories TopView(const std::filesystem::path& estimate_file, const std::vector<StampedPose>& truth) {
+  Trajectories plot;
+  const std::vector<StampedPose> estimate = ReadTum(estimate_file);
+  if (estimate.empty() || truth.empty()) return plot;
+  auto nearest = [&](double t) {
+    size_t best = 0;
+    for (size_t i = 1; i < truth.size(); ++i) {
+      if (std::abs(truth[i].timestamp - t) < std::abs(truth[best].timestamp - t)) best = i;
+    }
+    return truth[best].world_from_camera;
+  };
+  const Rigid3 world_from_first = nearest(estimate.front().timestamp);
+  for (const StampedPose& pose : estimate) {
+    const Eigen::Vector3d position = (world_from_first * pose.world_from_camera).translation;
+    plot.estimate.x.push_back(position.x());
+    plot.estimate.y.push_back(position.z());
+    const Eigen::Vector3d true_position = nearest(pose.timestamp).translation;
+    plot.truth.x.push_back(true_position.x());
+    plot.truth.y.push_back(true_position.z());
+  }
+  return plot;
+}
+
+// The frame with each evaluated point drawn in its depth error, green (0) to red (≥ `full_mm`).
+cv::Mat DepthErrorImage(const SequenceReader& sequence, int frame, double scale,
+                        const std::vector<std::array<double, 3>>& points, double full_mm) {
+  cv::Mat image = sequence.ReadRgb(frame) * 0.6;
+  const cv::Mat depth = sequence.ReadDepthMm(frame);
+  for (const auto& [u, v, z] : points) {
+    const auto truth = SampleDepth(depth, cv::Point2d(u, v));
+    if (!truth) continue;
+    const double error = std::min(1.0, std::abs(scale * z - *truth) / full_mm);
+    const cv::Scalar colour(0, 255 * (1.0 - error), 255 * error);  // BGR
+    cv::circle(image, cv::Point(cvRound(u), cvRound(v)), 3, colour, cv::FILLED, cv::LINE_AA);
+  }
+  return image;
+}
+
+// One run's section: plots and images, or why they are missing.
+std::string RunSection(const RunResult& result, const std::filesystem::path& folder) {
+  std::ostringstream html;
+  const std::string key = result.sequence + (result.label.empty() ? "" : " [" + result.label + "]");
+  html << "<section><h2 id=\"" << Html(Slug(result)) << "\">" << Html(key) << "</h2>\n";
+  if (result.status == "failed") {
+    html << "<p class=\"failed\">Failed: " << Html(result.error) << "</p></section>\n";
+    return html.str();
+  }
+  html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
+       << FormatFixed(result.rmse_mm, 3) << " mm (median " << FormatFixed(result.rmse_median_mm, 3)
+       << "), run folder <code>" << Html(result.run_folder) << "</code></p>\n";
+  try {
+    const std::filesystem::path run = result.run_folder;
+    std::ifstream config_stream(run / "config.json");
+    const Json config = Json::parse(config_stream);
+    const SequenceReader sequence(config.at("sequence").get<std::string>());
+    const auto metrics = ReadCsv(run / "metrics.csv");
+    PlotSeries rmse{"depth RMSE", "#1f77b4", {}, {}};
+    std::map<int, double> scales;
+    std::vector<int> tracked;
+    for (const auto& row : metrics) {
+      if (row.at("state") != "tracking") continue;
+      const int frame = static_cast<int>(Number(row, "frame"));
+      rmse.x.push_back(frame);
+      rmse.y.push_back(Number(row, "rmse_mm"));
+      scales[frame] = Number(row, "scale");
+      tracked.push_back(frame);
+    }
+    html << "<div class=\"plots\">"
+         << LinePlotSvg({rmse}, {"Depth RMSE per frame", "frame", "RMSE (mm)", 520, 300, false});
+    if (sequence.has_groundtruth() && std::filesystem::exists(run / "trajectory.tum")) {
+      const Trajectories top = TopView(run / "trajectory.tum", sequence.groundtruth());
+      html << LinePlotSvg({top.truth, top.estimate}, {"Trajectory, top view", "x (mm)", "z (mm)", 520, 300, true});
+    }
+    html << "</div>\n";
+    if (sequence.has_depth() && tracked.size() > 1) {
+      // The first frame after initialisation, the middle one and the last tracked one.
+      const std::set<int> shown = {tracked[1], tracked[tracked.size() / 2], tracked.back()};
+      std::map<int, std::vector<std::array<double, 3>>> points;
+      for (const auto& row : ReadCsv(run / "points.csv")) {
+        const int frame = static_cast<int>(Number(row, "frame"));
+        if (shown.count(frame)) points[frame].push_back({Number(row, "u"), Number(row, "v"), Number(row, "z_est")});
+      }
+      const double full_mm = std::max(1.0, 3.0 * result.rmse_mm);
+      html << "<p>Depth error of each tracked point, green = 0 to red ≥ " << FormatFixed(full_mm, 1)
+           << " mm:</p><div class=\"images\">";
+      for (int frame : shown) {
+        const std::string name = Slug(result) + "_depth_error_" + std::to_string(frame) + ".png";
+        cv::imwrite((folder / name).string(), DepthErrorImage(sequence, frame, scales[frame], points[frame], full_mm));
+        html << "<figure><img src=\"" << Html(name) << "\" width=\"320\"><figcaption>frame " << frame
+             << "</figcaption></figure>";
+      }
+      html << "</div>\n";
+    }
+  } catch (const std::exception& e) {
+    html << "<p class=\"failed\">No plots: " << Html(e.what()) << "</p>\n";
+  }
+  html << "</section>\n";
+  return html.str();
+}
+
+// With sweeps: mean RMSE against each swept option's value, one line per sequence.
+std::string SweepSection(const std::vector<RunResult>& results) {
+  std::map<std::string, std::map<std::string, std::map<double, double>>> curves;  // option → sequence → x → rmse
+  for (const RunResult& r : results) {
+    if (r.status != "ok") continue;
+    for (const std::string& assignment : r.point) {
+      const size_t equals = assignment.find('=');
+      try {
+        curves[assignment.substr(0, equals)][r.sequence][std::stod(assignment.substr(equals + 1))] = r.rmse_mm;
+      } catch (const std::exception&) {
+        // A non-numeric value (e.g. a weighting name) has no axis to plot on.
+      }
+    }
+  }
+  if (curves.empty()) return "";
+  static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"};
+  std::ostringstream html;
+  html << "<section><h2>Sweeps</h2><p>RMSE of the runs that tracked every frame, against each swept option "
+          "(with several options swept, the last point of the others wins).</p><div class=\"plots\">";
+  for (const auto& [option, sequences] : curves) {
+    std::vector<PlotSeries> series;
+    for (const auto& [sequence, points] : sequences) {
+      PlotSeries s{sequence, kColours[series.size() % 8], {}, {}, true};
+      for (const auto& [x, y] : points) {
+        s.x.push_back(x);
+        s.y.push_back(y);
+      }
+      series.push_back(s);
+    }
+    html << LinePlotSvg(series, {"RMSE against " + option, option, "RMSE (mm)", 520, 300, false});
+  }
+  html << "</div></section>\n";
+  return html.str();
+}
+
+}  // namespace
+
+void WriteReport(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>nrslam evaluation</title>\n"
+          "<style>body{font-family:sans-serif;margin:24px;max-width:1200px}table{border-collapse:collapse}"
+          "td,th{padding:3px 10px;border-bottom:1px solid #ddd;text-align:right}td:first-child,th:first-child"
+          "{text-align:left}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
+          "figure{margin:0}section{margin-top:28px}</style></head><body>\n<h1>nrslam evaluation</h1>\n";
+  html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
+          "<th>fps</th></tr>\n";
+  for (const RunResult& r : results) {
+    const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
+    html << "<tr><td><a href=\"#" << Html(Slug(r)) << "\">" << Html(key) << "</a></td>";
+    if (r.status == "failed") {
+      html << "<td class=\"failed\">FAILED</td><td colspan=\"5\" class=\"failed\">" << Html(r.error) << "</td></tr>\n";
+      continue;
+    }
+    html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"
+         << r.frames_total << "</td><td>" << FormatFixed(r.rmse_mm, 3) << "</td><td>"
+         << FormatFixed(r.rmse_median_mm, 3) << "</td><td>" << FormatFixed(r.fps, 1) << "</td></tr>\n";
+  }
+  html << "</table>\n" << SweepSection(results);
+  for (const RunResult& r : results) html << RunSection(r, folder);
+  // Self-check for people and for the test that opens the page in a headless browser.
+  html << "<script>window.addEventListener('load',()=>{const i=[...document.images];"
+          "document.body.dataset.check='images='+i.length+' broken='+i.filter(x=>!(x.complete&&x.naturalWidth>0)).length"
+          "+' plots='+document.querySelectorAll('svg.plot').length"
+          "+' series='+document.querySelectorAll('svg.plot polyline.series').length;});</script>\n";
+  html << "</body></html>\n";
+  std::ofstream(folder / "index.html") << html.str();
+}
+
+}  // namespace nrslam

@@ -1,0 +1,18 @@
+// batch: the HTML report of an evaluation — the results table, and per run its RMSE over
+// time, its trajectory against the ground truth (top view), and depth-error images of a few
+// frames; with sweeps, RMSE against each swept option. One folder, no scripts from the
+// network: it opens offline and can be archived with the results.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "nrslam/batch/results.h"
+
+namespace nrslam {
+
+// Writes `folder`/index.html and its images. A run whose folder or sequence cannot be read
+// gets a note in the page instead of its plots; the report is still written.
+void WriteReport(const std::vector<RunResult>& results, const std::filesystem::path& folder);
+
+}  // namespace nrslam
