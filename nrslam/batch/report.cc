@@ -16,18 +16,6 @@
 namespace nrslam {
 namespace {
 
-std::string Html(const std::string& text) {
-  std::string escaped;
-  for (char c : text) {
-    if (c == '<') escaped += "&lt;";
-    else if (c == '>') escaped += "&gt;";
-    else if (c == '&') escaped += "&amp;";
-    else if (c == '"') escaped += "&quot;";
-    else escaped += c;
-  }
-  return escaped;
-}
-
 // A file-name-safe version of a run's key.
 std::string Slug(const RunResult& result) {
   std::string slug = result.sequence + (result.label.empty() ? "" : "__" + result.label);
@@ -117,14 +105,14 @@ cv::Mat DepthErrorImage(const SequenceReader& sequence, int frame, double scale,
 std::string RunSection(const RunResult& result, const std::filesystem::path& folder) {
   std::ostringstream html;
   const std::string key = result.sequence + (result.label.empty() ? "" : " [" + result.label + "]");
-  html << "<section><h2 id=\"" << Html(Slug(result)) << "\">" << Html(key) << "</h2>\n";
+  html << "<section><h2 id=\"" << EscapeXml(Slug(result)) << "\">" << EscapeXml(key) << "</h2>\n";
   if (result.status == "failed") {
-    html << "<p class=\"failed\">Failed: " << Html(result.error) << "</p></section>\n";
+    html << "<p class=\"failed\">Failed: " << EscapeXml(result.error) << "</p></section>\n";
     return html.str();
   }
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << FormatFixed(result.rmse_mm, 3) << " mm (median " << FormatFixed(result.rmse_median_mm, 3)
-       << "), run folder <code>" << Html(result.run_folder) << "</code></p>\n";
+       << "), run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
     std::ifstream config_stream(run / "config.json");
@@ -163,13 +151,13 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
       for (int frame : shown) {
         const std::string name = Slug(result) + "_depth_error_" + std::to_string(frame) + ".png";
         cv::imwrite((folder / name).string(), DepthErrorImage(sequence, frame, scales[frame], points[frame], full_mm));
-        html << "<figure><img src=\"" << Html(name) << "\" width=\"320\"><figcaption>frame " << frame
+        html << "<figure><img src=\"" << EscapeXml(name) << "\" width=\"320\"><figcaption>frame " << frame
              << "</figcaption></figure>";
       }
       html << "</div>\n";
     }
   } catch (const std::exception& e) {
-    html << "<p class=\"failed\">No plots: " << Html(e.what()) << "</p>\n";
+    html << "<p class=\"failed\">No plots: " << EscapeXml(e.what()) << "</p>\n";
   }
   html << "</section>\n";
   return html.str();
@@ -224,9 +212,9 @@ void WriteReport(const std::vector<RunResult>& results, const std::filesystem::p
           "<th>fps</th></tr>\n";
   for (const RunResult& r : results) {
     const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
-    html << "<tr><td><a href=\"#" << Html(Slug(r)) << "\">" << Html(key) << "</a></td>";
+    html << "<tr><td><a href=\"#" << EscapeXml(Slug(r)) << "\">" << EscapeXml(key) << "</a></td>";
     if (r.status == "failed") {
-      html << "<td class=\"failed\">FAILED</td><td colspan=\"5\" class=\"failed\">" << Html(r.error) << "</td></tr>\n";
+      html << "<td class=\"failed\">FAILED</td><td colspan=\"5\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
       continue;
     }
     html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"

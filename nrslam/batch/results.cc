@@ -30,6 +30,16 @@ std::string CsvField(const std::string& text) {
   return quoted + "\"";
 }
 
+// The figures a run's summary.json and a results.json row share, under the same keys.
+void ReadFigures(const Json& json, RunResult* result) {
+  result->init_frame = json.value("init_frame", -1);
+  result->frames_tracked = json.value("frames_tracked", 0);
+  result->frames_total = json.value("frames_total", 0);
+  result->rmse_mm = json.value("rmse_mm", 0.0);
+  result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
+  result->fps = json.value("fps", 0.0);
+}
+
 }  // namespace
 
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
@@ -42,13 +52,7 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
     result.run_folder = run.run_folder.string();
     try {
       if (std::filesystem::exists(run.run_folder / "summary.json")) {
-        const Json summary = ReadJson(run.run_folder / "summary.json");
-        result.init_frame = summary.value("init_frame", -1);
-        result.frames_tracked = summary.value("frames_tracked", 0);
-        result.frames_total = summary.value("frames_total", 0);
-        result.rmse_mm = summary.value("rmse_mm", 0.0);
-        result.rmse_median_mm = summary.value("rmse_median_mm", 0.0);
-        result.fps = summary.value("fps", 0.0);
+        ReadFigures(ReadJson(run.run_folder / "summary.json"), &result);
         result.status = result.frames_tracked + std::max(result.init_frame, 0) >= result.frames_total ? "ok" : "lost";
       } else if (std::filesystem::exists(run.run_folder / "failure.json")) {
         result.error = ReadJson(run.run_folder / "failure.json").value("error", "unknown failure");
@@ -84,12 +88,7 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
       r.point = row.value("point", std::vector<std::string>{});
       r.status = row.at("status");
       r.error = row.value("error", "");
-      r.init_frame = row.value("init_frame", -1);
-      r.frames_tracked = row.value("frames_tracked", 0);
-      r.frames_total = row.value("frames_total", 0);
-      r.rmse_mm = row.value("rmse_mm", 0.0);
-      r.rmse_median_mm = row.value("rmse_median_mm", 0.0);
-      r.fps = row.value("fps", 0.0);
+      ReadFigures(row, &r);
       r.run_folder = row.value("run_folder", "");
       results.push_back(r);
     }

@@ -24,18 +24,19 @@ std::string Number(double value) {
   return text.str();
 }
 
-std::string Escape(const std::string& text) {
+}  // namespace
+
+std::string EscapeXml(const std::string& text) {
   std::string escaped;
   for (char c : text) {
     if (c == '<') escaped += "&lt;";
     else if (c == '>') escaped += "&gt;";
     else if (c == '&') escaped += "&amp;";
+    else if (c == '"') escaped += "&quot;";
     else escaped += c;
   }
   return escaped;
 }
-
-}  // namespace
 
 std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions& options) {
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min, y_min = x_min, y_max = -x_min;
@@ -68,7 +69,7 @@ std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions
   std::ostringstream svg;
   svg << "<svg class=\"plot\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << options.width << "\" height=\""
       << options.height << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
-  svg << "<text x=\"" << left << "\" y=\"16\" font-size=\"13\" font-weight=\"bold\">" << Escape(options.title)
+  svg << "<text x=\"" << left << "\" y=\"16\" font-size=\"13\" font-weight=\"bold\">" << EscapeXml(options.title)
       << "</text>\n";
   svg << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << plot_w << "\" height=\"" << plot_h
       << "\" fill=\"none\" stroke=\"#888\"/>\n";
@@ -84,15 +85,15 @@ std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions
         << Number(y) << "</text>\n";
   }
   svg << "<text x=\"" << left + plot_w / 2 << "\" y=\"" << options.height - 6 << "\" text-anchor=\"middle\">"
-      << Escape(options.x_label) << "</text>\n";
+      << EscapeXml(options.x_label) << "</text>\n";
   svg << "<text transform=\"translate(14," << top + plot_h / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << Escape(options.y_label) << "</text>\n";
+      << EscapeXml(options.y_label) << "</text>\n";
   double legend_x = left + plot_w;
   for (auto s = series.rbegin(); s != series.rend(); ++s) {
     legend_x -= 12 + 7 * static_cast<double>(s->name.size()) + 20;
     svg << "<line x1=\"" << legend_x << "\" y1=\"" << top - 8 << "\" x2=\"" << legend_x + 16 << "\" y2=\"" << top - 8
         << "\" stroke=\"" << s->colour << "\" stroke-width=\"2\"/><text x=\"" << legend_x + 20 << "\" y=\"" << top - 4
-        << "\">" << Escape(s->name) << "</text>\n";
+        << "\">" << EscapeXml(s->name) << "</text>\n";
   }
   for (const PlotSeries& s : series) {
     std::ostringstream points;

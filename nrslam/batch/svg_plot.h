@@ -20,6 +20,9 @@ struct PlotOptions {
   bool equal_aspect = false;      // same scale on both axes (trajectories)
 };
 
+// Text made safe inside HTML/SVG elements and attribute values.
+std::string EscapeXml(const std::string& text);
+
 // An <svg> element (class "plot") with axes, ticks, the series and a legend.
 std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions& options);
 
