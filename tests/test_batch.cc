@@ -2,6 +2,8 @@
 // resumed sweeps, the baseline check, and jobs emitted for GNU parallel then merged.
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include <fstream>
 #include <sstream>
 
@@ -9,12 +11,14 @@
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
+#include "nrslam/sim/renderer.h"
 #include "temp_folder.h"
 
 namespace nrslam {
 namespace {
 
-const Programs kPrograms{NRSLAM_TOOLS_DIR "/nrslam_simulate", NRSLAM_TOOLS_DIR "/nrslam_run"};
+const Programs kPrograms{NRSLAM_TOOLS_DIR "/nrslam_simulate", NRSLAM_TOOLS_DIR "/nrslam_run",
+                         NRSLAM_TOOLS_DIR "/nrslam_import"};
 
 std::filesystem::path WriteFile(const std::filesystem::path& file, const std::string& text) {
   std::filesystem::create_directories(file.parent_path());
@@ -83,7 +87,7 @@ TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
       LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [{"name": "s", "preset": "sim-0"}, {"name": "t", "preset": "sim-0"}]})"));
   const EvaluationPlan plan =
       PlanEvaluation(manifest, {}, {ParseSweep("k=0.5,2"), ParseSweep("max_degree_D=3,5,10")}, folder / "out", folder / "cache");
-  EXPECT_EQ(plan.renders.size(), 1u);  // both sequences are the same render
+  EXPECT_EQ(plan.prepares.size(), 1u);  // both sequences are the same render
   ASSERT_EQ(plan.runs.size(), 12u);
   EXPECT_EQ(plan.runs[0].label, "k=0.5,max_degree_D=3");
   EXPECT_EQ(plan.runs[5].label, "k=2,max_degree_D=10");
@@ -175,6 +179,51 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
       << page.substr(0, 2000);
   EXPECT_NE(page.find("Failed: exit code 1"), std::string::npos);
   EXPECT_EQ(browser.find("Uncaught"), std::string::npos) << browser;
+  std::filesystem::remove_all(folder);
+}
+
+// A Hamlyn-layout copy of a short simulated sequence (left images, 16-bit depth in mm,
+// intrinsics.txt), as a user would have the real dataset on disk.
+void WriteHamlynLayout(const std::filesystem::path& folder, int frames) {
+  SimOptions sim = SimPreset("sim-1");
+  sim.camera.width = 320;
+  sim.camera.height = 240;
+  Renderer renderer(sim);
+  std::filesystem::create_directories(folder / "image01");
+  std::filesystem::create_directories(folder / "depth01");
+  for (int i = 0; i < frames; ++i) {
+    const RenderedFrame frame = renderer.Render(i);
+    char name[32];
+    std::snprintf(name, sizeof name, "%010d.png", i);
+    cv::imwrite((folder / "image01" / name).string(), frame.left.bgr);
+    cv::Mat depth;
+    frame.left.depth_mm.convertTo(depth, CV_16U);  // whole mm, as the dataset stores it
+    cv::imwrite((folder / "depth01" / name).string(), depth);
+  }
+  const Camera& camera = renderer.camera();
+  std::ofstream(folder / "intrinsics.txt") << camera.fx() << " 0 " << camera.cx() << "\n0 " << camera.fy() << " "
+                                           << camera.cy() << "\n0 0 1\n";
+}
+
+TEST(BatchEvaluation, ImportedDatasetsRunAndAMissingOneIsReported) {
+  const auto folder = UniqueTempFolder("batch_import");
+  WriteHamlynLayout(folder / "hamlyn" / "rectified01", 8);
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({
+    "sequences": [
+      {"name": "h01", "import": {"format": "hamlyn", "path": "hamlyn/rectified01"}},
+      {"name": "h02", "import": {"format": "hamlyn", "path": "hamlyn/rectified02"}}
+    ]})"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  ASSERT_EQ(plan.prepares.size(), 2u);
+  ExecutePlan(plan, kPrograms, 2, [](const std::string&) {});
+  const std::vector<RunResult> results = CollectResults(plan);
+  EXPECT_EQ(results[0].status, "ok") << results[0].error;
+  EXPECT_EQ(results[0].frames_tracked, 8);
+  EXPECT_GT(results[0].rmse_mm, 0.0);
+  EXPECT_LT(results[0].rmse_mm, 2.0);  // whole-mm ground truth: a sane, not a tight, bound
+  EXPECT_EQ(results[1].status, "failed");
+  EXPECT_NE(results[1].error.find("importing hamlyn"), std::string::npos) << results[1].error;
+  EXPECT_NE(results[1].error.find("rectified02 does not exist"), std::string::npos) << results[1].error;
   std::filesystem::remove_all(folder);
 }
 

@@ -20,7 +20,7 @@ nrslam::Programs SiblingPrograms() {
   std::error_code error;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
   const std::filesystem::path folder = error ? std::filesystem::path(".") : self.parent_path();
-  return {folder / "nrslam_simulate", folder / "nrslam_run"};
+  return {folder / "nrslam_simulate", folder / "nrslam_run", folder / "nrslam_import"};
 }
 
 nrslam::Json ReadJsonFile(const std::filesystem::path& file) {
@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
   app.add_option("manifest", manifest_path, "manifest JSON (see data_manifests/)");
   app.add_option("--out", out, "result folder: runs/<sequence>[/<sweep point>], results.json, results.csv")
       ->capture_default_str();
-  app.add_option("--cache", cache, "where simulator presets are rendered, shared between evaluations")
+  app.add_option("--cache", cache, "where presets are rendered and datasets imported, shared between evaluations")
       ->capture_default_str();
   app.add_option("--jobs,-j", jobs, "processes at once")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");

@@ -82,19 +82,38 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
   const std::filesystem::path cache_folder = std::filesystem::absolute(cache);
   const std::filesystem::path out_folder = std::filesystem::absolute(out);
   for (const ManifestSequence& sequence : manifest.sequences) {
-    int render = -1;
+    int prepare = -1;
     std::filesystem::path folder = sequence.path;
-    if (!sequence.preset.empty()) {
-      std::string key = sequence.preset;
-      for (const std::string& assignment : sequence.simulate) key += "\n" + assignment;
-      folder = cache_folder / (sequence.preset + "-" + StableHash(key));
-      for (size_t i = 0; i < plan.renders.size() && render < 0; ++i) {
-        if (plan.renders[i].folder == folder) render = static_cast<int>(i);
+    if (!sequence.preset.empty() || !sequence.import.empty()) {
+      PrepareJob job;
+      job.import = !sequence.import.empty();
+      if (job.import) {
+        job.arguments = sequence.import;
+        for (size_t i = 0; i + 1 < job.arguments.size(); i += 2) {
+          if (job.arguments[i] == "--format" || job.arguments[i] == "--in") {
+            job.description += (job.description.empty() ? "" : " ") + job.arguments[i + 1];
+          }
+        }
+      } else {
+        job.arguments = {"--preset", sequence.preset, "--quiet"};
+        for (const std::string& assignment : sequence.simulate) {
+          job.arguments.push_back("--set");
+          job.arguments.push_back(assignment);
+        }
+        job.description = sequence.preset;
       }
-      if (render < 0) {
-        render = static_cast<int>(plan.renders.size());
-        plan.renders.push_back({sequence.preset, sequence.simulate, folder});
+      std::string key;
+      for (const std::string& argument : job.arguments) key += argument + "\n";
+      const std::string stem = job.import ? sequence.name : sequence.preset;
+      job.folder = cache_folder / (stem + "-" + StableHash(key));
+      for (size_t i = 0; i < plan.prepares.size() && prepare < 0; ++i) {
+        if (plan.prepares[i].folder == job.folder) prepare = static_cast<int>(i);
       }
+      if (prepare < 0) {
+        prepare = static_cast<int>(plan.prepares.size());
+        plan.prepares.push_back(job);
+      }
+      folder = job.folder;
     }
     for (const auto& point : points) {
       RunJob run;
@@ -107,7 +126,7 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
       run.sequence_folder = folder;
       run.run_folder = out_folder / "runs" / sequence.name;
       if (!run.label.empty()) run.run_folder /= run.label;
-      run.render = render;
+      run.prepare = prepare;
       std::vector<std::string> assignments = sequence.assignments;
       assignments.insert(assignments.end(), extra.begin(), extra.end());
       assignments.insert(assignments.end(), point.begin(), point.end());
@@ -131,62 +150,65 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
   return plan;
 }
 
-std::string RenderShellLine(const RenderJob& render, const Programs& programs) {
-  std::vector<std::string> argv = {programs.simulate.string(), "--preset", render.preset, "--quiet"};
-  for (const std::string& assignment : render.simulate) {
-    argv.push_back("--set");
-    argv.push_back(assignment);
-  }
-  const std::string folder = ShellLine({render.folder.string()});
-  const std::string partial = ShellLine({render.folder.string() + ".partial.XXXXXX"});
-  // Render into a private folder and move it into place: a concurrent render of the same
-  // preset on another machine loses the race harmlessly, an interrupted one leaves no trace.
-  return "{ [ -d " + folder + " ] || { mkdir -p " + ShellLine({render.folder.parent_path().string()}) +
-         " && T=$(mktemp -d " + partial + ") && " + ShellLine(argv) + " --out \"$T/sequence\"; mv -T \"$T/sequence\" " +
-         folder + " 2>/dev/null; rm -rf \"$T\"; [ -d " + folder + " ]; }; }";
+namespace {
+
+std::vector<std::string> PrepareCommand(const PrepareJob& prepare, const Programs& programs) {
+  std::vector<std::string> argv = {(prepare.import ? programs.import : programs.simulate).string()};
+  argv.insert(argv.end(), prepare.arguments.begin(), prepare.arguments.end());
+  return argv;
+}
+
+}  // namespace
+
+std::string PrepareShellLine(const PrepareJob& prepare, const Programs& programs) {
+  const std::string folder = ShellLine({prepare.folder.string()});
+  const std::string partial = ShellLine({prepare.folder.string() + ".partial.XXXXXX"});
+  // Make it in a private folder and move that into place: a concurrent job on another
+  // machine loses the race harmlessly, an interrupted one leaves no trace.
+  return "{ [ -d " + folder + " ] || { mkdir -p " + ShellLine({prepare.folder.parent_path().string()}) +
+         " && T=$(mktemp -d " + partial + ") && " + ShellLine(PrepareCommand(prepare, programs)) +
+         " --out \"$T/sequence\"; mv -T \"$T/sequence\" " + folder + " 2>/dev/null; rm -rf \"$T\"; [ -d " + folder +
+         " ]; }; }";
 }
 
 std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Programs& programs) {
   std::vector<std::string> argv = {programs.run.string()};
   argv.insert(argv.end(), run.arguments.begin(), run.arguments.end());
   const std::string command = ShellLine(argv);
-  if (run.render < 0) return command;
-  return RenderShellLine(plan.renders[run.render], programs) + " && " + command;
+  if (run.prepare < 0) return command;
+  return PrepareShellLine(plan.prepares[run.prepare], programs) + " && " + command;
 }
 
 bool RunIsFinished(const RunJob& run) { return std::filesystem::exists(run.run_folder / "summary.json"); }
 
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
                  const std::function<void(const std::string&)>& progress) {
-  // Renders first: several runs may share one.
-  std::vector<Command> renders;
-  std::vector<size_t> render_index;
-  for (size_t i = 0; i < plan.renders.size(); ++i) {
-    const RenderJob& render = plan.renders[i];
-    if (std::filesystem::exists(render.folder)) continue;
-    std::filesystem::create_directories(render.folder.parent_path());
-    std::filesystem::remove_all(render.folder.string() + ".partial");
-    Command command{{programs.simulate.string(), "--preset", render.preset, "--out", render.folder.string() + ".partial",
-                     "--quiet"},
-                    render.folder.string() + ".log"};
-    for (const std::string& assignment : render.simulate) {
-      command.argv.push_back("--set");
-      command.argv.push_back(assignment);
-    }
-    renders.push_back(command);
-    render_index.push_back(i);
+  // Sequences first: several runs may share one.
+  std::vector<Command> prepares;
+  std::vector<size_t> prepare_index;
+  for (size_t i = 0; i < plan.prepares.size(); ++i) {
+    const PrepareJob& prepare = plan.prepares[i];
+    if (std::filesystem::exists(prepare.folder)) continue;
+    std::filesystem::create_directories(prepare.folder.parent_path());
+    std::filesystem::remove_all(prepare.folder.string() + ".partial");
+    Command command{PrepareCommand(prepare, programs), prepare.folder.string() + ".log"};
+    command.argv.insert(command.argv.end(), {"--out", prepare.folder.string() + ".partial"});
+    prepares.push_back(command);
+    prepare_index.push_back(i);
   }
-  std::vector<std::string> render_errors(plan.renders.size());
-  RunCommands(renders, jobs, [&](size_t k, const ProcessOutcome& outcome) {
-    const RenderJob& render = plan.renders[render_index[k]];
+  std::vector<std::string> prepare_errors(plan.prepares.size());
+  RunCommands(prepares, jobs, [&](size_t k, const ProcessOutcome& outcome) {
+    const PrepareJob& prepare = plan.prepares[prepare_index[k]];
+    const std::string verb = prepare.import ? "imported " : "rendered ";
     if (outcome.ok()) {
-      std::filesystem::rename(render.folder.string() + ".partial", render.folder);
-      progress("rendered " + render.folder.filename().string());
+      std::filesystem::rename(prepare.folder.string() + ".partial", prepare.folder);
+      progress(verb + prepare.folder.filename().string());
     } else {
-      const std::string why = LastLine(renders[k].log);
-      render_errors[render_index[k]] = "rendering " + render.preset + " failed (" + outcome.Describe() + ")" +
-                                       (why.empty() ? "" : ": " + why);
-      progress(render_errors[render_index[k]]);
+      const std::string why = LastLine(prepares[k].log);
+      prepare_errors[prepare_index[k]] = (prepare.import ? "importing " : "rendering ") + prepare.description +
+                                         " failed (" + outcome.Describe() + ")" + (why.empty() ? "" : ": " + why);
+      std::filesystem::remove_all(prepare.folder.string() + ".partial");
+      progress(prepare_errors[prepare_index[k]]);
     }
   });
 
@@ -200,8 +222,8 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
       continue;
     }
     std::filesystem::remove(run.run_folder / "failure.json");
-    if (run.render >= 0 && !render_errors[run.render].empty()) {
-      WriteFailure(run, "render", render_errors[run.render]);
+    if (run.prepare >= 0 && !prepare_errors[run.prepare].empty()) {
+      WriteFailure(run, "prepare", prepare_errors[run.prepare]);
       continue;
     }
     std::filesystem::create_directories(run.run_folder.parent_path());

@@ -19,10 +19,13 @@ struct Sweep {
 // Parses "name=v1,v2,v3" (name as for ResolveRunOption); throws Error when malformed.
 Sweep ParseSweep(const std::string& text);
 
-struct RenderJob {
-  std::string preset;
-  std::vector<std::string> simulate;  // simulator assignments
-  std::filesystem::path folder;       // the cached sequence: cache/<preset>-<hash of options>
+// A sequence made before its runs, into the cache: a preset rendered (nrslam_simulate) or a
+// dataset imported (nrslam_import). Its folder name is keyed by what makes it.
+struct PrepareJob {
+  std::string description;              // "sim-3" or "hamlyn /data/h01", for messages
+  bool import = false;                  // nrslam_import rather than nrslam_simulate
+  std::vector<std::string> arguments;   // the program's arguments, without --out
+  std::filesystem::path folder;         // cache/<name>-<hash of the arguments>
 };
 
 struct RunJob {
@@ -32,11 +35,11 @@ struct RunJob {
   std::filesystem::path sequence_folder;
   std::filesystem::path run_folder;          // out/runs/<sequence>[/<label>]
   std::vector<std::string> arguments;        // nrslam_run's arguments (no program name)
-  int render = -1;                           // index into EvaluationPlan::renders, or -1
+  int prepare = -1;                          // index into EvaluationPlan::prepares, or -1
 };
 
 struct EvaluationPlan {
-  std::vector<RenderJob> renders;
+  std::vector<PrepareJob> prepares;
   std::vector<RunJob> runs;
 };
 
@@ -49,18 +52,19 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
 struct Programs {
   std::filesystem::path simulate;  // nrslam_simulate
   std::filesystem::path run;       // nrslam_run
+  std::filesystem::path import;    // nrslam_import
 };
 
-// The shell command that renders a preset into the cache (atomically, so concurrent or
-// interrupted renders never leave a half-written sequence behind), if not there yet.
-std::string RenderShellLine(const RenderJob& render, const Programs& programs);
-// The shell command of one run, self-contained: renders its sequence first if needed.
+// The shell command that prepares a sequence into the cache (atomically, so concurrent or
+// interrupted ones never leave a half-written sequence behind), if not there yet.
+std::string PrepareShellLine(const PrepareJob& prepare, const Programs& programs);
+// The shell command of one run, self-contained: prepares its sequence first if needed.
 std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Programs& programs);
 
 // A run whose folder already holds a summary.json finished before: it is not run again.
 bool RunIsFinished(const RunJob& run);
 
-// Renders what is missing, then runs what is not finished, `jobs` processes at a time.
+// Prepares what is missing, then runs what is not finished, `jobs` processes at a time.
 // `progress` gets one line per finished step. Failures are recorded in the run folders
 // (failure.json), never thrown.
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,

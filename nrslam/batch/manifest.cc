@@ -4,6 +4,7 @@
 #include <fstream>
 #include <set>
 
+#include "nrslam/datasets/dataset_import.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/system/system_options.h"
 
@@ -30,8 +31,12 @@ std::string Assignment(const std::string& path, const Json& value) {
 namespace {
 
 // The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).
-const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "simulate", "set", "init",
+const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "import", "simulate", "set", "init",
                                              "rigid", "first_frame", "last_frame"};
+
+// The keys of an "import" object: nrslam_import's options by their long names.
+const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
+                                           "depth_unit_mm", "near", "far", "scene_unit_mm"};
 
 void Require(bool condition, const std::string& context, const std::string& message) {
   if (!condition) throw Error(context + ": " + message);
@@ -48,7 +53,7 @@ Json WithDefaults(const Json& defaults, const Json& entry) {
     }
   }
   // Default simulator options concern the presets only.
-  if (merged.contains("path") && !entry.contains("simulate")) merged.erase("simulate");
+  if (!merged.contains("preset") && !entry.contains("simulate")) merged.erase("simulate");
   return merged;
 }
 
@@ -63,9 +68,31 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
   sequence.name = entry["name"];
   Require(sequence.name.find_first_of("/\\ ") == std::string::npos && sequence.name != "." && sequence.name != "..",
           context, "name '" + sequence.name + "' must not contain '/', '\\' or spaces");
-  const bool has_path = entry.contains("path"), has_preset = entry.contains("preset");
-  Require(has_path != has_preset, context, "needs exactly one of \"path\" (a sequence folder) or \"preset\"");
-  if (has_path) {
+  const bool has_path = entry.contains("path"), has_preset = entry.contains("preset"), has_import = entry.contains("import");
+  Require(has_path + has_preset + has_import == 1, context,
+          "needs exactly one of \"path\" (a sequence folder), \"preset\" or \"import\"");
+  if (has_import) {
+    const Json& import = entry["import"];
+    Require(import.is_object() && import.contains("format") && import.contains("path") && import["path"].is_string(),
+            context, "\"import\" needs at least \"format\" and \"path\"");
+    Require(!entry.contains("simulate"), context, "\"simulate\" only applies to a preset");
+    for (const auto& [key, value] : import.items()) {
+      Require(kImportKeys.count(key) > 0, context, "import: unknown key '" + key + "'");
+      std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+      if (key == "path" || key == "calibration") {
+        std::filesystem::path file(text);
+        if (file.is_relative()) file = folder / file;
+        text = file.lexically_normal().string();
+      }
+      std::string option = key == "path" ? "in" : key;
+      std::replace(option.begin(), option.end(), '_', '-');
+      sequence.import.push_back("--" + option);
+      sequence.import.push_back(text);
+    }
+    const std::vector<std::string> formats = ImportFormats();
+    Require(std::find(formats.begin(), formats.end(), import["format"]) != formats.end(), context,
+            "import: unknown format " + import["format"].dump());
+  } else if (has_path) {
     Require(entry["path"].is_string(), context, "\"path\" must be a string");
     sequence.path = std::filesystem::path(entry["path"].get<std::string>());
     if (sequence.path.is_relative()) sequence.path = folder / sequence.path;
@@ -142,7 +169,7 @@ Manifest LoadManifest(const std::filesystem::path& file) {
   manifest.description = json.value("description", "");
   const Json defaults = json.value("defaults", Json::object());
   Require(defaults.is_object(), where, "\"defaults\" must be an object");
-  for (const char* key : {"name", "path", "preset"}) {
+  for (const char* key : {"name", "path", "preset", "import"}) {
     Require(!defaults.contains(key), where, std::string("\"defaults\" cannot hold \"") + key + "\"");
   }
   std::set<std::string> names;

@@ -5,13 +5,16 @@
 //     "defaults": { "set": {"deformation.k": 1.1}, "simulate": {"frames": 60} },
 //     "sequences": [
 //       {"name": "sim-3", "preset": "sim-3", "simulate": {"camera.width": 320, "camera.height": 240}},
-//       {"name": "mine", "path": "../data/mine", "first_frame": 10, "last_frame": 200, "rigid": true}
+//       {"name": "mine", "path": "../data/mine", "first_frame": 10, "last_frame": 200, "rigid": true},
+//       {"name": "h01", "import": {"format": "hamlyn", "path": "/data/hamlyn/rectified01"}}
 //     ]
 //   }
 //
-// A sequence is a folder in the sequence format (`path`, relative to the manifest) or a
+// A sequence is a folder in the sequence format (`path`, relative to the manifest), a
 // simulator preset (`preset`, with `simulate` options by their nrslam_simulate --set paths),
-// rendered on demand into a cache. Per sequence and in `defaults`: `set` (run options by
+// or a public dataset on disk (`import`: "format", "path" and any nrslam_import option by its
+// long name, e.g. "calibration", "max_frames", "scene_unit_mm"); presets and imports are
+// made on demand into a cache. Per sequence and in `defaults`: `set` (run options by
 // their nrslam_run --set path, or by a unique last name such as "k"), `init`, `rigid`,
 // `first_frame`, `last_frame`. Everything is validated when the manifest is loaded.
 #pragma once
@@ -26,9 +29,10 @@ namespace nrslam {
 
 struct ManifestSequence {
   std::string name;                       // unique within the manifest; names the run folder
-  std::filesystem::path path;             // a sequence folder (absolute), or empty for a preset
-  std::string preset;                     // simulator preset, or empty for a folder
+  std::filesystem::path path;             // a sequence folder (absolute), or empty
+  std::string preset;                     // simulator preset, or empty
   std::vector<std::string> simulate;      // simulator assignments "path=value", sorted
+  std::vector<std::string> import;        // nrslam_import arguments (no --out), or empty
   std::vector<std::string> assignments;   // run assignments "module.option=value"
   bool rigid = false;
 };

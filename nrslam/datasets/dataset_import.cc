@@ -1,0 +1,326 @@
+#include "nrslam/datasets/dataset_import.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <sstream>
+
+#include "nrslam/io/sequence_writer.h"
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace fs = std::filesystem;
+
+namespace {
+
+// What an importer found: per-frame readers and the sequence-level facts.
+struct FrameSource {
+  int count = 0;
+  Camera camera;
+  std::function<cv::Mat(int)> rgb;       // BGR
+  std::function<cv::Mat(int)> depth_mm;  // CV_32F mm, 0 = none; empty when no depth
+  std::function<cv::Mat(int)> right;     // empty when no right camera
+  double baseline_mm = 0.0;
+  std::vector<Rigid3> world_from_camera;  // per frame, or empty
+};
+
+[[noreturn]] void Fail(const ImportOptions& options, const std::string& message) {
+  throw Error(options.format + " dataset " + options.input.string() + ": " + message);
+}
+
+cv::Mat ReadImage(const ImportOptions& options, const fs::path& file, int flags) {
+  cv::Mat image = cv::imread(file.string(), flags);
+  if (image.empty()) Fail(options, "cannot read " + file.string() + " (missing or corrupt)");
+  return image;
+}
+
+// Image files of a folder, sorted by name.
+std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suffix = "") {
+  std::vector<fs::path> files;
+  if (!fs::is_directory(folder)) return files;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    std::string extension = entry.path().extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+    const bool image = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
+                       extension == ".tif" || extension == ".tiff";
+    const std::string stem = entry.path().stem().string();
+    const bool matches = suffix.empty() || (stem.size() > suffix.size() && stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0);
+    if (entry.is_regular_file() && image && matches) files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::vector<double> Numbers(const std::string& line) {
+  std::string spaced = line;
+  std::replace(spaced.begin(), spaced.end(), ',', ' ');
+  std::replace(spaced.begin(), spaced.end(), ';', ' ');
+  std::istringstream stream(spaced);
+  std::vector<double> numbers;
+  std::string token;
+  while (stream >> token) {
+    char* end = nullptr;
+    const double value = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0') return {};  // not a line of numbers
+    numbers.push_back(value);
+  }
+  return numbers;
+}
+
+// A ground-truth file needs a pose for every frame; extra poses (a longer recording) are cut.
+void KeepOnePosePerFrame(const ImportOptions& options, const std::string& file, FrameSource* source) {
+  if (static_cast<int>(source->world_from_camera.size()) < source->count) {
+    Fail(options, file + " has " + std::to_string(source->world_from_camera.size()) + " poses for " +
+                      std::to_string(source->count) + " frames");
+  }
+  source->world_from_camera.resize(source->count);
+}
+
+Camera LoadCalibration(const ImportOptions& options) {
+  std::ifstream stream(options.calibration);
+  if (!stream) Fail(options, "cannot read the calibration file " + options.calibration.string());
+  try {
+    Camera camera = nlohmann::json::parse(stream).get<Camera>();
+    camera.Check();
+    return camera;
+  } catch (const std::exception& e) {
+    Fail(options, "calibration " + options.calibration.string() + ": " + e.what());
+  }
+}
+
+FrameSource EndomapperSim(const ImportOptions& options) {
+  FrameSource source;
+  auto rgb_file = [&](int i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "image_%04d.png", i);
+    return options.input / "rgb" / name;
+  };
+  auto depth_file = [&](int i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "aov_image_%04d.exr", i);
+    return options.input / "depth" / name;
+  };
+  while (fs::exists(rgb_file(source.count))) ++source.count;
+  if (source.count == 0) Fail(options, "no rgb/image_0000.png");
+  for (int i = 0; i < source.count; ++i) {
+    if (!fs::exists(depth_file(i))) Fail(options, "missing " + depth_file(i).string());
+  }
+  const cv::Mat first = ReadImage(options, rgb_file(0), cv::IMREAD_COLOR);
+  source.camera = options.calibration.empty()
+                      ? Camera::Pinhole(first.cols, first.rows, 472.6496, 472.6496, 0.5 * (first.cols - 1),
+                                        0.5 * (first.rows - 1))
+                      : LoadCalibration(options);
+  source.rgb = [&options, rgb_file](int i) { return ReadImage(options, rgb_file(i), cv::IMREAD_COLOR); };
+  source.depth_mm = [&options, depth_file](int i) {
+    const cv::Mat raw = ReadImage(options, depth_file(i), cv::IMREAD_UNCHANGED);
+    if (raw.depth() != CV_32F) Fail(options, depth_file(i).string() + " is not a float EXR");
+    cv::Mat buffer;
+    cv::extractChannel(raw, buffer, raw.channels() >= 3 ? 2 : 0);  // R in OpenCV's BGR order
+    cv::Mat depth(buffer.size(), CV_32F, cv::Scalar(0));
+    const double near = options.near, far = options.far;
+    for (int y = 0; y < buffer.rows; ++y) {
+      for (int x = 0; x < buffer.cols; ++x) {
+        const double d = buffer.at<float>(y, x);  // Unity reversed Z: 1 at near, 0 at far
+        if (!(d > 0.0) || d > 1.0) continue;      // far plane (no surface) or invalid
+        const double z = 1.0 / ((1.0 - far / near) / far * (1.0 - d) + (far / near) / far);
+        depth.at<float>(y, x) = static_cast<float>(z * options.scene_unit_mm);
+      }
+    }
+    return depth;
+  };
+  std::ifstream trajectory(options.input / "trajectory.csv");
+  if (!trajectory) Fail(options, "missing trajectory.csv");
+  std::string line;
+  std::getline(trajectory, line);  // header
+  for (int row = 2; std::getline(trajectory, line); ++row) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<double> v = Numbers(line);
+    if (v.size() < 7) Fail(options, "trajectory.csv line " + std::to_string(row) + ": expected tX;tY;tZ;rX;rY;rZ;rW;time");
+    const Rigid3 camera_from_world(Eigen::Quaterniond(v[6], v[3], v[4], v[5]),
+                                   Eigen::Vector3d(v[0], v[1], v[2]) * options.scene_unit_mm);
+    source.world_from_camera.push_back(camera_from_world.Inverse());
+  }
+  KeepOnePosePerFrame(options, "trajectory.csv", &source);
+  return source;
+}
+
+FrameSource Hamlyn(const ImportOptions& options) {
+  FrameSource source;
+  const std::vector<fs::path> left = ImageFiles(options.input / "image01");
+  const std::vector<fs::path> right = ImageFiles(options.input / "image02");
+  const std::vector<fs::path> depth = ImageFiles(options.input / "depth01");
+  if (left.empty()) Fail(options, "no images in image01/");
+  if (!right.empty() && right.size() != left.size()) {
+    Fail(options, "image02/ has " + std::to_string(right.size()) + " images, image01/ " + std::to_string(left.size()));
+  }
+  if (!depth.empty() && depth.size() != left.size()) {
+    Fail(options, "depth01/ has " + std::to_string(depth.size()) + " images, image01/ " + std::to_string(left.size()));
+  }
+  source.count = static_cast<int>(left.size());
+  std::ifstream intrinsics(options.input / "intrinsics.txt");
+  if (!intrinsics) Fail(options, "missing intrinsics.txt");
+  std::vector<double> numbers;
+  std::string line;
+  while (std::getline(intrinsics, line)) {
+    const std::vector<double> row = Numbers(line);
+    numbers.insert(numbers.end(), row.begin(), row.end());
+  }
+  if (numbers.size() < 9) Fail(options, "intrinsics.txt: expected a 3x3 matrix K");
+  const cv::Mat first = ReadImage(options, left[0], cv::IMREAD_COLOR);
+  source.camera = options.calibration.empty()
+                      ? Camera::Pinhole(first.cols, first.rows, numbers[0], numbers[4], numbers[2], numbers[5])
+                      : LoadCalibration(options);
+  source.rgb = [&options, left](int i) { return ReadImage(options, left[i], cv::IMREAD_COLOR); };
+  if (!right.empty() && numbers.size() >= 10) {
+    source.baseline_mm = std::abs(numbers[9]);
+    source.right = [&options, right](int i) { return ReadImage(options, right[i], cv::IMREAD_COLOR); };
+  }
+  if (!depth.empty()) {
+    source.depth_mm = [&options, depth](int i) {
+      const cv::Mat raw = ReadImage(options, depth[i], cv::IMREAD_UNCHANGED);
+      if (raw.type() != CV_16UC1) Fail(options, depth[i].string() + " is not a 16-bit single-channel image");
+      cv::Mat mm;
+      raw.convertTo(mm, CV_32F);  // already mm
+      return mm;
+    };
+  }
+  return source;
+}
+
+FrameSource C3vd(const ImportOptions& options) {
+  if (options.calibration.empty()) Fail(options, "needs --calibration (a camera JSON)");
+  FrameSource source;
+  const std::vector<fs::path> colour = ImageFiles(options.input, "_color");
+  if (colour.empty()) Fail(options, "no NNNN_color.png frames");
+  std::vector<fs::path> depth;
+  for (const fs::path& file : colour) {
+    const std::string stem = file.stem().string();
+    const fs::path depth_file = file.parent_path() / (stem.substr(0, stem.size() - 6) + "_depth.tiff");
+    if (!fs::exists(depth_file)) Fail(options, "missing " + depth_file.string());
+    depth.push_back(depth_file);
+  }
+  source.count = static_cast<int>(colour.size());
+  source.camera = LoadCalibration(options);
+  source.rgb = [&options, colour](int i) { return ReadImage(options, colour[i], cv::IMREAD_COLOR); };
+  source.depth_mm = [&options, depth](int i) {
+    const cv::Mat raw = ReadImage(options, depth[i], cv::IMREAD_UNCHANGED);
+    if (raw.type() != CV_16UC1) Fail(options, depth[i].string() + " is not a 16-bit single-channel TIFF");
+    cv::Mat mm;
+    raw.convertTo(mm, CV_32F, 100.0 / 65535.0);
+    return mm;
+  };
+  std::ifstream poses(options.input / "pose.txt");
+  if (!poses) Fail(options, "missing pose.txt");
+  std::string line;
+  for (int row = 1; std::getline(poses, line); ++row) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<double> v = Numbers(line);
+    if (v.size() != 16) Fail(options, "pose.txt line " + std::to_string(row) + ": expected 16 numbers (a 4x4 matrix)");
+    // Row-major keeps the translation in entries 3, 7, 11; column-major in 12, 13, 14.
+    const bool column_major = std::abs(v[12]) + std::abs(v[13]) + std::abs(v[14]) > std::abs(v[3]) + std::abs(v[7]) + std::abs(v[11]);
+    Eigen::Matrix4d matrix;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) matrix(r, c) = column_major ? v[c * 4 + r] : v[r * 4 + c];
+    }
+    const Eigen::Matrix3d rotation = matrix.topLeftCorner<3, 3>();
+    if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3) {
+      Fail(options, "pose.txt line " + std::to_string(row) + ": not a rotation");
+    }
+    source.world_from_camera.emplace_back(Eigen::Quaterniond(rotation), matrix.topRightCorner<3, 1>());
+  }
+  KeepOnePosePerFrame(options, "pose.txt", &source);
+  return source;
+}
+
+FrameSource Images(const ImportOptions& options) {
+  if (options.calibration.empty()) Fail(options, "needs --calibration (a camera JSON)");
+  FrameSource source;
+  source.camera = LoadCalibration(options);
+  if (fs::is_directory(options.input)) {
+    const std::vector<fs::path> files = ImageFiles(options.input);
+    if (files.empty()) Fail(options, "no image files in the folder");
+    source.count = static_cast<int>(files.size());
+    source.rgb = [&options, files](int i) { return ReadImage(options, files[i], cv::IMREAD_COLOR); };
+    return source;
+  }
+  // A video: count the frames first (grab without decoding), then decode them in order.
+  cv::VideoCapture counter(options.input.string());
+  if (!counter.isOpened()) Fail(options, "cannot open it as an image folder or a video");
+  while (counter.grab()) ++source.count;
+  if (source.count == 0) Fail(options, "the video has no frames");
+  auto video = std::make_shared<cv::VideoCapture>(options.input.string());
+  source.rgb = [&options, video](int i) {
+    cv::Mat frame;
+    if (!video->read(frame)) Fail(options, "cannot decode video frame " + std::to_string(i));
+    return frame;
+  };
+  return source;
+}
+
+}  // namespace
+
+void ImportOptions::Check() const {
+  const std::vector<std::string> formats = ImportFormats();
+  if (std::find(formats.begin(), formats.end(), format) == formats.end()) {
+    std::string known;
+    for (const std::string& name : formats) known += (known.empty() ? "" : ", ") + name;
+    throw Error("unknown dataset format '" + format + "' (known: " + known + ")");
+  }
+  if (!fs::exists(input)) throw Error(format + " dataset: " + input.string() + " does not exist");
+  if (!(fps > 0) || max_frames < 0 || !(depth_unit_mm > 0) || !(near > 0) || !(far > near) || !(scene_unit_mm > 0)) {
+    throw Error("import options: need fps > 0, max_frames >= 0, depth_unit_mm > 0, 0 < near < far, scene_unit_mm > 0");
+  }
+}
+
+std::vector<std::string> ImportFormats() { return {"endomapper-sim", "hamlyn", "c3vd", "images"}; }
+
+SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
+  options.Check();
+  // OpenCV 4.6 reads EXR only when asked to (CVE hardening); the Endomapper depth is EXR.
+  setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+  FrameSource source = options.format == "endomapper-sim" ? EndomapperSim(options)
+                       : options.format == "hamlyn"       ? Hamlyn(options)
+                       : options.format == "c3vd"         ? C3vd(options)
+                                                          : Images(options);
+  const int count = options.max_frames > 0 ? std::min(options.max_frames, source.count) : source.count;
+  SequenceInfo info;
+  info.camera = source.camera;
+  info.fps = options.fps;
+  info.frame_count = count;
+  info.depth_unit_mm = options.depth_unit_mm;
+  if (source.right) info.stereo = StereoInfo{source.baseline_mm, source.camera};
+  info.provenance = {{"generator", std::string("nrslam_import ") + NRSLAM_VERSION},
+                     {"format", options.format},
+                     {"source", fs::absolute(options.input).string()}};
+  const SequenceWriter writer(out, info, static_cast<bool>(source.depth_mm));
+  const cv::Size size(source.camera.width(), source.camera.height());
+  for (int i = 0; i < count; ++i) {
+    const cv::Mat rgb = source.rgb(i);
+    if (rgb.size() != size) {
+      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
+                        " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    }
+    writer.WriteRgb(i, rgb);
+    if (source.right) writer.WriteRight(i, source.right(i));
+    if (source.depth_mm) {
+      const cv::Mat depth = source.depth_mm(i);
+      if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(i) + " has another size than the image");
+      writer.WriteDepthMm(i, depth);
+    }
+  }
+  if (!source.world_from_camera.empty()) {
+    std::vector<StampedPose> poses;
+    for (int i = 0; i < count; ++i) poses.push_back({i / options.fps, source.world_from_camera[i]});
+    writer.WriteGroundtruth(poses);
+  }
+  return info;
+}
+
+}  // namespace nrslam

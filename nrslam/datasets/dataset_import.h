@@ -1,0 +1,46 @@
+// datasets: importing public dataset layouts into the sequence format.
+//
+//   endomapper-sim  rgb/image_%04d.png, depth/aov_image_%04d.exr (Unity reversed-Z depth
+//                   buffer in channel R, linearised with near/far), trajectory.csv
+//                   ("tX;tY;tZ;rX;rY;rZ;rW;time", camera_from_world). Pinhole; default
+//                   intrinsics are the Endomapper simulation's (fx = fy = 472.6496, principal
+//                   point at the image centre) unless a calibration file is given.
+//   hamlyn          rectified: image01/ (left), image02/ (right), depth01/ (16-bit, mm),
+//                   intrinsics.txt (3×3 K, optionally a 4th line with the baseline in mm).
+//   c3vd            NNNN_color.png, NNNN_depth.tiff (16-bit, 0–65535 ↦ 0–100 mm), pose.txt
+//                   (one 4×4 world_from_camera per line, 16 numbers, mm; row- or column-major
+//                   is recognised from where the translation is). Calibration file required.
+//   images          a folder of images (sorted by name) or a video file, with a calibration
+//                   file; no ground truth (runs need monocular initialisation).
+//
+// A calibration file is a JSON camera as in sequence.json ("model", "width", "height", "fx",
+// "fy", "cx", "cy", and "k" for kannala_brandt).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "nrslam/io/sequence_info.h"
+
+namespace nrslam {
+
+struct ImportOptions {
+  std::string format;                  // endomapper-sim, hamlyn, c3vd, images
+  std::filesystem::path input;         // the dataset's folder (or video file for "images")
+  std::filesystem::path calibration;   // camera JSON; required for c3vd and images
+  double fps = 30.0;                   // frames per second (timestamps of the ground truth)
+  int max_frames = 0;                  // import at most this many frames; 0 = all
+  double depth_unit_mm = 0.01;         // resolution of the written 16-bit depth, mm
+  double near = 0.01, far = 4.0;       // endomapper-sim: depth-buffer planes, scene units
+  double scene_unit_mm = 1000.0;       // endomapper-sim: mm per scene unit (Unity: metres)
+  void Check() const;
+};
+
+std::vector<std::string> ImportFormats();
+
+// Reads the dataset at options.input and writes a complete sequence folder at `out`.
+// Throws Error naming the format, the file and what is wrong.
+SequenceInfo ImportDataset(const ImportOptions& options, const std::filesystem::path& out);
+
+}  // namespace nrslam

@@ -1,0 +1,209 @@
+// Dataset importers: each public layout, written as a small fixture with known depth and
+// poses, imports into a sequence that the reader accepts, with the depth and poses decoded
+// as the layout defines them; broken layouts are named.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include "nrslam/datasets/dataset_import.h"
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/util/error.h"
+#include "temp_folder.h"
+
+namespace nrslam {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr int kWidth = 64, kHeight = 48, kFrames = 3;
+
+cv::Mat Frame(int index) {
+  cv::Mat image(kHeight, kWidth, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  image.row(0).setTo(cv::Scalar(index * 40, 0, 0));  // frames differ, and we can tell which is which
+  return image;
+}
+
+void WriteCalibration(const fs::path& file) {
+  std::ofstream(file) << R"({"model": "pinhole", "width": 64, "height": 48, "fx": 50, "fy": 51, "cx": 31.5, "cy": 23.5})";
+}
+
+std::string ImportError(const ImportOptions& options, const fs::path& out) {
+  try {
+    ImportDataset(options, out);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+ImportOptions Options(const std::string& format, const fs::path& input) {
+  ImportOptions options;
+  options.format = format;
+  options.input = input;
+  return options;
+}
+
+Rigid3 Pose(int index) {
+  return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * index, Eigen::Vector3d(0.3, 1, 0.2).normalized())),
+                Eigen::Vector3d(1.0 * index, -2.0, 0.5 * index));
+}
+
+void ExpectSamePose(const Rigid3& a, const Rigid3& b, double tolerance) {
+  EXPECT_LT((a.translation - b.translation).norm(), tolerance);
+  EXPECT_LT(a.rotation.angularDistance(b.rotation), 1e-6);
+}
+
+TEST(DatasetImport, EndomapperSimulatedReversedZDepthAndInvertedPoses) {
+  setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 1);
+  const fs::path in = UniqueTempFolder("endomapper_in"), out = UniqueTempFolder("endomapper_out");
+  fs::create_directories(in / "rgb");
+  fs::create_directories(in / "depth");
+  // Reversed Z with near 0.01 and far 4: z = 0.05 scene units (50 mm) ↔ d = (far/z − 1)/(far/near − 1).
+  const double near = 0.01, far = 4.0, z = 0.05;
+  const float d = static_cast<float>((far / z - 1.0) / (far / near - 1.0));
+  std::ofstream trajectory(in / "trajectory.csv");
+  trajectory << "tX;tY;tZ;rX;rY;rZ;rW;time\n";
+  for (int i = 0; i < kFrames; ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "rgb/image_%04d.png", i);
+    cv::imwrite((in / name).string(), Frame(i));
+    cv::Mat exr(kHeight, kWidth, CV_32FC3, cv::Scalar(0, 0, d));  // R channel holds the buffer
+    exr.at<cv::Vec3f>(0, 0) = cv::Vec3f(0, 0, 0);                  // far plane: no surface
+    std::snprintf(name, sizeof name, "depth/aov_image_%04d.exr", i);
+    ASSERT_TRUE(cv::imwrite((in / name).string(), exr));
+    const Rigid3 camera_from_world = Pose(i).Inverse();  // the file stores T_cw, in metres
+    const Eigen::Vector3d t = camera_from_world.translation / 1000.0;
+    const Eigen::Quaterniond& q = camera_from_world.rotation;
+    trajectory << t.x() << ';' << t.y() << ';' << t.z() << ';' << q.x() << ';' << q.y() << ';' << q.z() << ';' << q.w()
+               << ';' << i / 30.0 << '\n';
+  }
+  trajectory.close();
+  ImportOptions options = Options("endomapper-sim", in);
+  ImportDataset(options, out);
+  const SequenceReader sequence(out);
+  EXPECT_EQ(sequence.frame_count(), kFrames);
+  EXPECT_DOUBLE_EQ(sequence.info().camera.fx(), 472.6496);
+  const cv::Mat depth = sequence.ReadDepthMm(1);
+  EXPECT_NEAR(depth.at<float>(10, 10), 50.0, 0.01);
+  EXPECT_EQ(depth.at<float>(0, 0), 0.f);
+  ASSERT_EQ(sequence.groundtruth().size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-3);
+  EXPECT_EQ(sequence.ReadRgb(2).at<cv::Vec3b>(0, 0)[0], 80);
+
+  fs::remove(in / "depth" / "aov_image_0002.exr");
+  EXPECT_NE(ImportError(options, out).find("missing " + (in / "depth" / "aov_image_0002.exr").string()), std::string::npos);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
+  const fs::path in = UniqueTempFolder("hamlyn_in"), out = UniqueTempFolder("hamlyn_out");
+  for (const char* folder : {"image01", "image02", "depth01"}) fs::create_directories(in / folder);
+  for (int i = 0; i < kFrames; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%010d.png", i);
+    cv::imwrite((in / "image01" / name).string(), Frame(i));
+    cv::imwrite((in / "image02" / name).string(), Frame(i + 10));
+    cv::imwrite((in / "depth01" / name).string(), cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)));
+  }
+  std::ofstream(in / "intrinsics.txt") << "50.5 0 31.2\n0 50.7 23.9\n0 0 1\n5.38\n";
+  ImportOptions options = Options("hamlyn", in);
+  ImportDataset(options, out);
+  const SequenceReader sequence(out);
+  EXPECT_EQ(sequence.frame_count(), kFrames);
+  EXPECT_DOUBLE_EQ(sequence.info().camera.fx(), 50.5);
+  EXPECT_DOUBLE_EQ(sequence.info().camera.cy(), 23.9);
+  ASSERT_TRUE(sequence.has_right());
+  EXPECT_DOUBLE_EQ(sequence.info().stereo->baseline_mm, 5.38);
+  EXPECT_FLOAT_EQ(sequence.ReadDepthMm(2).at<float>(5, 5), 62.f);
+  EXPECT_FALSE(sequence.has_groundtruth());
+
+  fs::remove(in / "image02" / "0000000001.png");
+  EXPECT_NE(ImportError(options, out).find("image02/ has 2 images, image01/ 3"), std::string::npos);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+// C3VD poses come as one 4×4 per line; the importer must read both storage orders.
+void C3vdFixture(const fs::path& in, bool column_major) {
+  fs::create_directories(in);
+  std::ofstream poses(in / "pose.txt");
+  for (int i = 0; i < kFrames; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%04d_color.png", i);
+    cv::imwrite((in / name).string(), Frame(i));
+    std::snprintf(name, sizeof name, "%04d_depth.tiff", i);
+    cv::imwrite((in / name).string(), cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(13107 * (i + 1))));  // 20, 40, 60 mm
+    Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
+    matrix.topLeftCorner<3, 3>() = Pose(i).rotation.toRotationMatrix();
+    matrix.topRightCorner<3, 1>() = Pose(i).translation;
+    for (int k = 0; k < 16; ++k) {
+      poses << (k ? "," : "") << (column_major ? matrix(k % 4, k / 4) : matrix(k / 4, k % 4));
+    }
+    poses << '\n';
+  }
+}
+
+TEST(DatasetImport, C3vdDepthScaleAndBothPoseOrders) {
+  for (bool column_major : {false, true}) {
+    const fs::path in = UniqueTempFolder("c3vd_in"), out = UniqueTempFolder("c3vd_out");
+    C3vdFixture(in, column_major);
+    WriteCalibration(in / "camera.json");
+    ImportOptions options = Options("c3vd", in);
+    EXPECT_NE(ImportError(options, out).find("needs --calibration"), std::string::npos);
+    options.calibration = in / "camera.json";
+    ImportDataset(options, out);
+    const SequenceReader sequence(out);
+    EXPECT_EQ(sequence.frame_count(), kFrames);
+    EXPECT_DOUBLE_EQ(sequence.info().camera.fy(), 51.0);
+    EXPECT_NEAR(sequence.ReadDepthMm(1).at<float>(3, 3), 40.0, 0.01);
+    ASSERT_EQ(sequence.groundtruth().size(), static_cast<size_t>(kFrames));
+    for (int i = 0; i < kFrames; ++i) ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-4);
+    fs::remove_all(in);
+    fs::remove_all(out);
+  }
+}
+
+TEST(DatasetImport, PlainImageFolderAndVideoWithACalibration) {
+  const fs::path in = UniqueTempFolder("images_in"), out = UniqueTempFolder("images_out");
+  fs::create_directories(in / "frames");
+  for (int i = 0; i < kFrames; ++i) cv::imwrite((in / "frames" / ("f" + std::to_string(i) + ".jpg")).string(), Frame(i));
+  WriteCalibration(in / "camera.json");
+  ImportOptions options = Options("images", in / "frames");
+  options.calibration = in / "camera.json";
+  ImportDataset(options, out);
+  {
+    const SequenceReader sequence(out);
+    EXPECT_EQ(sequence.frame_count(), kFrames);
+    EXPECT_FALSE(sequence.has_depth());
+    EXPECT_FALSE(sequence.has_groundtruth());
+  }
+  // A video (Motion JPEG, which OpenCV encodes without external codecs).
+  {
+    cv::VideoWriter video((in / "clip.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30,
+                          cv::Size(kWidth, kHeight));
+    ASSERT_TRUE(video.isOpened());
+    for (int i = 0; i < 5; ++i) video.write(Frame(i));
+  }
+  fs::remove_all(out);
+  options.input = in / "clip.avi";
+  ImportDataset(options, out);
+  EXPECT_EQ(SequenceReader(out).frame_count(), 5);
+  // A calibration for another image size is caught.
+  std::ofstream(in / "wrong.json") << R"({"model": "pinhole", "width": 640, "height": 480, "fx": 500, "fy": 500, "cx": 319.5, "cy": 239.5})";
+  options.calibration = in / "wrong.json";
+  fs::remove_all(out);
+  EXPECT_NE(ImportError(options, out).find("is 64x48 but the camera is 640x480"), std::string::npos);
+  options.format = "hamlin";
+  EXPECT_NE(ImportError(options, out).find("unknown dataset format 'hamlin'"), std::string::npos);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+}  // namespace
+}  // namespace nrslam
