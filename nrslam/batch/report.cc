@@ -165,13 +165,16 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
 
 // With sweeps: mean RMSE against each swept option's value, one line per sequence.
 std::string SweepSection(const std::vector<RunResult>& results) {
-  std::map<std::string, std::map<std::string, std::map<double, double>>> curves;  // option → sequence → x → rmse
+  // option → sequence → value → (sum, n): each point averages over the other options' values.
+  std::map<std::string, std::map<std::string, std::map<double, std::pair<double, int>>>> curves;
   for (const RunResult& r : results) {
     if (r.status != "ok") continue;
     for (const std::string& assignment : r.point) {
       const size_t equals = assignment.find('=');
       try {
-        curves[assignment.substr(0, equals)][r.sequence][std::stod(assignment.substr(equals + 1))] = r.rmse_mm;
+        auto& cell = curves[assignment.substr(0, equals)][r.sequence][std::stod(assignment.substr(equals + 1))];
+        cell.first += r.rmse_mm;
+        cell.second += 1;
       } catch (const std::exception&) {
         // A non-numeric value (e.g. a weighting name) has no axis to plot on.
       }
@@ -180,19 +183,20 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   if (curves.empty()) return "";
   static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"};
   std::ostringstream html;
-  html << "<section><h2>Sweeps</h2><p>RMSE of the runs that tracked every frame, against each swept option "
-          "(with several options swept, the last point of the others wins).</p><div class=\"plots\">";
+  html << "<section><h2>Sweeps</h2><p>RMSE of the runs that tracked every frame against each swept option, "
+          "per sequence; with several options swept, each point is the mean over the others' values.</p>"
+          "<div class=\"plots\">";
   for (const auto& [option, sequences] : curves) {
     std::vector<PlotSeries> series;
     for (const auto& [sequence, points] : sequences) {
       PlotSeries s{sequence, kColours[series.size() % 8], {}, {}, true};
-      for (const auto& [x, y] : points) {
+      for (const auto& [x, cell] : points) {
         s.x.push_back(x);
-        s.y.push_back(y);
+        s.y.push_back(cell.first / cell.second);
       }
       series.push_back(s);
     }
-    html << LinePlotSvg(series, {"RMSE against " + option, option, "RMSE (mm)", 520, 300, false});
+    html << LinePlotSvg(series, {"RMSE against " + option, option, "mean RMSE (mm)", 520, 300, false});
   }
   html << "</div></section>\n";
   return html.str();

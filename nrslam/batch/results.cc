@@ -1,5 +1,6 @@
 #include "nrslam/batch/results.h"
 
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -145,12 +146,20 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     const bool ok = r.status == "ok";
     complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
   }
-  std::map<std::string, std::map<std::string, std::pair<double, int>>> by_value;  // option -> value -> (sum, n)
+  // Values in numeric order when they are numbers ("5" before "10"), else as text.
+  const auto value_order = [](const std::string& a, const std::string& b) {
+    char *end_a = nullptr, *end_b = nullptr;
+    const double x = std::strtod(a.c_str(), &end_a), y = std::strtod(b.c_str(), &end_b);
+    return *end_a == '\0' && *end_b == '\0' && x != y ? x < y : a < b;
+  };
+  using ValueCells = std::map<std::string, std::pair<double, int>, decltype(value_order)>;  // value -> (sum, n)
+  std::map<std::string, ValueCells> by_value;
   for (const RunResult& r : results) {
     if (!complete[r.sequence]) continue;
     for (const std::string& assignment : r.point) {
       const size_t equals = assignment.find('=');
-      auto& cell = by_value[assignment.substr(0, equals)][assignment.substr(equals + 1)];
+      auto& cells = by_value.try_emplace(assignment.substr(0, equals), value_order).first->second;
+      auto& cell = cells[assignment.substr(equals + 1)];
       cell.first += r.rmse_mm;
       cell.second += 1;
     }
