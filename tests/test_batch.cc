@@ -67,7 +67,7 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
     "defaults": {"set": {"k": 2, "max_degree_D": 4}, "simulate": {"frames": 9}},
     "sequences": [
       {"name": "s", "preset": "sim-1", "set": {"max_degree_D": 6}},
-      {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3}
+      {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3, "camera": "cams/f.json"}
     ]})"));
   ASSERT_EQ(manifest.sequences.size(), 2u);
   const ManifestSequence& s = manifest.sequences[0];
@@ -78,6 +78,8 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   EXPECT_EQ(f.path, (std::filesystem::absolute(folder) / "data" / "f").lexically_normal());
   EXPECT_TRUE(f.rigid);
   EXPECT_NE(std::find(f.assignments.begin(), f.assignments.end(), "run.first_frame=3"), f.assignments.end());
+  const std::string camera = "run.camera=" + (std::filesystem::absolute(folder) / "lists" / "cams" / "f.json").lexically_normal().string();
+  EXPECT_NE(std::find(f.assignments.begin(), f.assignments.end(), camera), f.assignments.end());
   std::filesystem::remove_all(folder);
 }
 

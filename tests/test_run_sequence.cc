@@ -41,17 +41,21 @@ std::vector<CsvPoint> ReadPointsCsv(const fs::path& path) {
   return points;
 }
 
+void SimulateSmall(const std::string& preset, int frames, int width, int height, const fs::path& folder) {
+  SimOptions sim = SimPreset(preset);
+  sim.frames = frames;
+  sim.camera.width = width;
+  sim.camera.height = height;
+  SimulateSequence(sim, preset + "-small", folder);
+}
+
 class RunSequenceTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // CTest runs each test case in its own process, in parallel: one folder per process.
     base_ = new fs::path(UniqueTempFolder("nrslam_run_test"));
     fs::remove_all(*base_);
-    SimOptions sim = SimPreset("sim-3");  // A = 5 mm, ω = 2.5 rad/s
-    sim.frames = 40;
-    sim.camera.width = 320;
-    sim.camera.height = 240;
-    SimulateSequence(sim, "sim-3-small", *base_ / "sequence");
+    SimulateSmall("sim-3", 40, 320, 240, *base_ / "sequence");  // A = 5 mm, ω = 2.5 rad/s
     summary_ = new RunSummary(RunSequence(*base_ / "sequence", SystemOptions{}, *base_ / "run"));
   }
   static void TearDownTestSuite() {
@@ -121,15 +125,42 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   EXPECT_EQ(std::count(std::istreambuf_iterator<char>(metrics), {}, '\n'), 41);  // header + one per frame
 }
 
+// run.camera replaces the sequence's calibration (e.g. a better one than the dataset's); it
+// must fit the images, and the run records which camera it used.
+TEST(RunSequenceCamera, OverrideIsUsedAndMustFitTheImages) {
+  const fs::path folder = UniqueTempFolder("nrslam_camera_override");
+  fs::remove_all(folder);
+  SimulateSmall("sim-1", 10, 320, 240, folder / "sequence");
+  const Camera own = SequenceReader(folder / "sequence").info().camera;
+  const Camera wrong_focal = Camera::Pinhole(320, 240, 1.3 * own.fx(), 1.3 * own.fy(), own.cx(), own.cy());
+  std::ofstream(folder / "focal.json") << nlohmann::json(wrong_focal).dump();
+  std::ofstream(folder / "size.json") << nlohmann::json(Camera::Pinhole(640, 480, 300, 300, 319.5, 239.5)).dump();
+
+  SystemOptions options;
+  const RunSummary baseline = RunSequence(folder / "sequence", options, folder / "own");
+  options.run.camera = (folder / "focal.json").string();
+  const RunSummary overridden = RunSequence(folder / "sequence", options, folder / "focal");
+  EXPECT_NE(baseline.rmse_mm, overridden.rmse_mm);  // the other calibration was really used
+  std::ifstream config_stream(folder / "focal" / "config.json");
+  const nlohmann::json config = nlohmann::json::parse(config_stream);
+  EXPECT_DOUBLE_EQ(config.at("camera").at("fx").get<double>(), wrong_focal.fx());
+
+  options.run.camera = (folder / "size.json").string();
+  try {
+    RunSequence(folder / "sequence", options, folder / "size");
+    FAIL() << "ran with a camera for other images";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is for 640x480 images, the sequence's are 320x240"), std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(folder);
+}
+
 TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   EXPECT_THROW(RunSequence("/nonexistent/sequence", SystemOptions{}, "/tmp/nrslam_never"), Error);
   const fs::path folder = UniqueTempFolder("nrslam_no_depth");
   fs::remove_all(folder);
-  SimOptions sim = SimPreset("sim-0");
-  sim.frames = 2;
-  sim.camera.width = 64;
-  sim.camera.height = 48;
-  SimulateSequence(sim, "tiny", folder);
+  SimulateSmall("sim-0", 2, 64, 48, folder);
   fs::remove_all(folder / "depth");
   try {
     RunSequence(folder, SystemOptions{}, folder / "run");

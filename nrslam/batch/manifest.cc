@@ -32,7 +32,7 @@ namespace {
 
 // The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).
 const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "import", "simulate", "set", "init",
-                                             "rigid", "first_frame", "last_frame"};
+                                             "rigid", "first_frame", "last_frame", "camera"};
 
 // The keys of an "import" object: nrslam_import's options by their long names.
 const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
@@ -131,6 +131,12 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
   if (entry.contains("init")) sequence.assignments.push_back(Assignment("run.init", entry["init"]));
   if (entry.contains("first_frame")) sequence.assignments.push_back(Assignment("run.first_frame", entry["first_frame"]));
   if (entry.contains("last_frame")) sequence.assignments.push_back(Assignment("run.last_frame", entry["last_frame"]));
+  if (entry.contains("camera")) {
+    Require(entry["camera"].is_string(), context, "\"camera\" must be the path of a camera JSON file");
+    std::filesystem::path file(entry["camera"].get<std::string>());
+    if (file.is_relative()) file = folder / file;
+    sequence.assignments.push_back("run.camera=" + file.lexically_normal().string());
+  }
   if (entry.contains("rigid")) {
     Require(entry["rigid"].is_boolean(), context, "\"rigid\" must be true or false");
     sequence.rigid = entry["rigid"];

@@ -16,7 +16,7 @@
 // long name, e.g. "calibration", "max_frames", "scene_unit_mm"); presets and imports are
 // made on demand into a cache. Per sequence and in `defaults`: `set` (run options by
 // their nrslam_run --set path, or by a unique last name such as "k"), `init`, `rigid`,
-// `first_frame`, `last_frame`. Everything is validated when the manifest is loaded.
+// `first_frame`, `last_frame`, `camera` (a camera JSON used instead of the sequence's). Everything is validated when the manifest is loaded.
 #pragma once
 
 #include <filesystem>

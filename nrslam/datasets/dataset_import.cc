@@ -12,6 +12,7 @@
 #include <optional>
 #include <sstream>
 
+#include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
 
@@ -84,14 +85,10 @@ void KeepOnePosePerFrame(const ImportOptions& options, const std::string& file, 
 }
 
 Camera LoadCalibration(const ImportOptions& options) {
-  std::ifstream stream(options.calibration);
-  if (!stream) Fail(options, "cannot read the calibration file " + options.calibration.string());
   try {
-    Camera camera = nlohmann::json::parse(stream).get<Camera>();
-    camera.Check();
-    return camera;
-  } catch (const std::exception& e) {
-    Fail(options, "calibration " + options.calibration.string() + ": " + e.what());
+    return ReadCameraFile(options.calibration);
+  } catch (const Error& e) {
+    Fail(options, e.what());
   }
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
 #include "nrslam/tracking/tracker.h"
@@ -16,6 +17,18 @@
 namespace nrslam {
 namespace fs = std::filesystem;
 namespace {
+
+// A calibration given for the run instead of the sequence's own: it must fit the images.
+Camera CameraOverride(const fs::path& file, const SequenceReader& reader) {
+  const Camera camera = ReadCameraFile(file);
+  const Camera& own = reader.info().camera;
+  if (camera.width() != own.width() || camera.height() != own.height()) {
+    throw Error("run.camera " + file.string() + " is for " + std::to_string(camera.width()) + "x" +
+                std::to_string(camera.height()) + " images, the sequence's are " + std::to_string(own.width()) + "x" +
+                std::to_string(own.height()));
+  }
+  return camera;
+}
 
 std::ofstream OpenForWriting(const fs::path& path) {
   std::ofstream file(path);
@@ -60,6 +73,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   if (options.run.init == "depth" && !reader.has_depth()) {
     throw Error("sequence " + sequence.string() + " has no depth/ folder: --init depth needs one");
   }
+  const Camera camera = options.run.camera.empty() ? reader.info().camera : CameraOverride(options.run.camera, reader);
   const int first = std::min(options.run.first_frame, reader.frame_count());
   const int last = options.run.last_frame < 0 ? reader.frame_count() : std::min(options.run.last_frame, reader.frame_count());
   if (first >= last) throw Error("the frame range selects no frame of " + sequence.string());
@@ -72,6 +86,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     config << nlohmann::json{{"nrslam_version", NRSLAM_VERSION},
                              {"sequence", fs::absolute(sequence).string()},
                              {"sequence_info", reader.info()},
+                             {"camera", camera},
                              {"options", options}}
                   .dump(2)
            << '\n';
@@ -83,7 +98,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                  "ms_deformation,ms_total,note\n";
   std::ofstream log = OpenForWriting(out / "run.log");
 
-  Tracker tracker(reader.info().camera, options.frontend, options.deformation, options.tracking);
+  Tracker tracker(camera, options.frontend, options.deformation, options.tracking);
   RunSummary summary;
   summary.frames_total = last - first;
   std::vector<FrameEvaluation> evaluations;

@@ -20,9 +20,11 @@ struct RunOptions {
                                         // paper's tracking experiment (frames after a loss count as lost)
   int first_frame = 0;         // frame range to process, [first_frame, last_frame); -1 = to the end
   int last_frame = -1;
+  std::string camera;          // a camera JSON (as in sequence.json) used instead of the sequence's; "" = its own
   void Check() const;
 };
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunOptions, init, mapping, reinitialise_after_loss, first_frame, last_frame)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunOptions, init, mapping, reinitialise_after_loss, first_frame, last_frame,
+                                                camera)
 
 struct SystemOptions {
   RunOptions run;
