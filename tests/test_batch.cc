@@ -229,6 +229,31 @@ TEST(BatchEvaluation, ImportedDatasetsRunAndAMissingOneIsReported) {
   std::filesystem::remove_all(folder);
 }
 
+// A runner that crashes (here: a stand-in that kills itself with SIGSEGV) or cannot be
+// started is a recorded failure of that run, with the reason; the batch finishes.
+TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
+  const auto folder = UniqueTempFolder("batch_crash");
+  const std::filesystem::path crasher = WriteFile(folder / "crash.sh", "#!/bin/sh\necho about to crash\nkill -SEGV $$\n");
+  std::filesystem::permissions(crasher, std::filesystem::perms::owner_all);
+  WriteFile(folder / "seq" / "sequence.json", "{}");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
+    {"name": "a", "path": "seq"}, {"name": "b", "path": "seq"}]})"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  ExecutePlan(plan, Programs{kPrograms.simulate, crasher, kPrograms.import}, 2, [](const std::string&) {});
+  for (const RunResult& result : CollectResults(plan)) {
+    EXPECT_EQ(result.status, "failed");
+    EXPECT_NE(result.error.find("killed by signal 11"), std::string::npos) << result.error;
+    EXPECT_NE(result.error.find("about to crash"), std::string::npos) << result.error;  // its last words
+  }
+  ExecutePlan(plan, Programs{kPrograms.simulate, folder / "no-such-program", kPrograms.import}, 2,
+              [](const std::string&) {});
+  for (const RunResult& result : CollectResults(plan)) {
+    EXPECT_EQ(result.status, "failed");
+    EXPECT_NE(result.error.find("cannot start"), std::string::npos) << result.error;
+  }
+  std::filesystem::remove_all(folder);
+}
+
 TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
   const auto folder = UniqueTempFolder("batch_resume");
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({
