@@ -23,16 +23,6 @@ nrslam::Programs SiblingPrograms() {
   return {folder / "nrslam_simulate", folder / "nrslam_run", folder / "nrslam_import"};
 }
 
-nrslam::Json ReadJsonFile(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw nrslam::Error("cannot open " + file.string());
-  try {
-    return nrslam::Json::parse(stream);
-  } catch (const nrslam::Json::exception& e) {
-    throw nrslam::Error(file.string() + " is not valid JSON (" + e.what() + ")");
-  }
-}
-
 // Exit codes: 0 all well, 1 bad usage or input, 2 some run failed, 3 baseline check failed.
 int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem::path& out,
            const std::string& check_baseline, const std::string& write_baseline, double tolerance) {
@@ -51,7 +41,7 @@ int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem:
     std::cout << "baseline written: " << write_baseline << '\n';
   }
   if (!check_baseline.empty()) {
-    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, ReadJsonFile(check_baseline));
+    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, nrslam::ReadJsonFile(check_baseline));
     std::cout << '\n' << check.report;
     if (!check.passed) code = 3;
   }

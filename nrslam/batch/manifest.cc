@@ -1,7 +1,6 @@
 #include "nrslam/batch/manifest.h"
 
 #include <algorithm>
-#include <fstream>
 #include <set>
 
 #include "nrslam/datasets/dataset_import.h"
@@ -155,13 +154,11 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
 
 Manifest LoadManifest(const std::filesystem::path& file) {
   const std::string where = "manifest " + file.string();
-  std::ifstream stream(file);
-  if (!stream) throw Error(where + ": cannot open the file");
   Json json;
   try {
-    json = Json::parse(stream);
-  } catch (const Json::exception& e) {
-    throw Error(where + ": not valid JSON (" + e.what() + ")");
+    json = ReadJsonFile(file);
+  } catch (const Error& e) {
+    throw Error(where + ": " + e.what());
   }
   Require(json.is_object(), where, "must be a JSON object with a \"sequences\" list");
   for (const auto& [key, value] : json.items()) {

@@ -115,8 +115,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
        << "), run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
-    std::ifstream config_stream(run / "config.json");
-    const Json config = Json::parse(config_stream);
+    const Json config = ReadJsonFile(run / "config.json");
     const SequenceReader sequence(config.at("sequence").get<std::string>());
     const auto metrics = ReadCsv(run / "metrics.csv");
     PlotSeries rmse{"depth RMSE", "#1f77b4", {}, {}};

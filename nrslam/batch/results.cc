@@ -14,16 +14,6 @@ std::string Key(const RunResult& result) {
   return result.label.empty() ? result.sequence : result.sequence + " [" + result.label + "]";
 }
 
-Json ReadJson(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw Error("cannot open " + file.string());
-  try {
-    return Json::parse(stream);
-  } catch (const Json::exception& e) {
-    throw Error(file.string() + " is not valid JSON (" + e.what() + ")");
-  }
-}
-
 std::string CsvField(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
   std::string quoted = "\"";
@@ -53,10 +43,10 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
     result.run_folder = run.run_folder.string();
     try {
       if (std::filesystem::exists(run.run_folder / "summary.json")) {
-        ReadFigures(ReadJson(run.run_folder / "summary.json"), &result);
+        ReadFigures(ReadJsonFile(run.run_folder / "summary.json"), &result);
         result.status = result.frames_tracked + std::max(result.init_frame, 0) >= result.frames_total ? "ok" : "lost";
       } else if (std::filesystem::exists(run.run_folder / "failure.json")) {
-        result.error = ReadJson(run.run_folder / "failure.json").value("error", "unknown failure");
+        result.error = ReadJsonFile(run.run_folder / "failure.json").value("error", "unknown failure");
       } else {
         result.error = "not run";
       }
@@ -112,7 +102,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
 }
 
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder) {
-  return ResultsFromJson(ReadJson(folder / "results.json"));
+  return ResultsFromJson(ReadJsonFile(folder / "results.json"));
 }
 
 void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {

@@ -1,18 +1,13 @@
 #include "nrslam/io/camera_file.h"
 
-#include <nlohmann/json.hpp>
-
-#include <fstream>
-
-#include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace nrslam {
 
 Camera ReadCameraFile(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw Error("cannot read the camera file " + file.string());
+  const Json json = ReadJsonFile(file);
   try {
-    Camera camera = nlohmann::json::parse(stream).get<Camera>();
+    Camera camera = json.get<Camera>();
     camera.Check();
     return camera;
   } catch (const std::exception& e) {

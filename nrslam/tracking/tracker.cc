@@ -126,18 +126,20 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
 
   cam_from_world_ = Rigid3();
   motion_ = Rigid3();
-  RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels), grey, mask);
+  RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels),
+                   BuildValidityMask(grey, mask, frontend_.masks));
   state_ = TrackingState::kTracking;
   result.state = state_;
   result.cam_from_world = cam_from_world_;
-  for (const PointTrack& track : tracks_) result.points.push_back({track.id, track.pixel});
-  result.klt_tracked = static_cast<int>(tracks_.size());
+  for (const PointTrack& track : tracks_) {
+    if (track.active) result.points.push_back({track.id, track.pixel});
+  }
+  result.klt_tracked = static_cast<int>(result.points.size());
   result.ms_total = MillisecondsSince(start);
   return result;
 }
 
-void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& grey,
-                               const cv::Mat& mask) {
+void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid) {
   std::vector<PointTrack> active;
   std::vector<cv::Point2f> pixels;
   for (const PointTrack& track : tracks_) {
@@ -145,21 +147,15 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
     active.push_back(track);
     pixels.push_back(track.pixel);
   }
-  const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
+  tracks_ = std::move(active);
   klt_.SetReference(*keyframe, pixels, valid);
-  tracks_.clear();
-  std::vector<cv::Point2f> kept_pixels;
-  for (size_t i = 0; i < active.size(); ++i) {
-    if (!klt_.has_reference(i)) {
-      LoseTrack(&active[i], frame);  // under the mask here; it may be seen again elsewhere
-      continue;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (klt_.has_reference(i)) {
+      tracks_[i].patch = {keyframe, tracks_[i].pixel};
+    } else {
+      LoseTrack(&tracks_[i], frame);  // under the mask here; it may be seen again elsewhere
     }
-    active[i].patch = {keyframe, active[i].pixel};
-    tracks_.push_back(active[i]);
-    kept_pixels.push_back(active[i].pixel);
   }
-  // Keep the KLT's reference points aligned with tracks_.
-  if (kept_pixels.size() != active.size()) klt_.SetReference(*keyframe, kept_pixels, valid);
   frames_since_keyframe_ = 0;
 }
 
@@ -200,13 +196,10 @@ void Tracker::ForgetLostPoints(int frame) {
   }
 }
 
-void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& grey, const cv::Mat& mask,
-                          FrameResult* result) {
-  if (!options_.reassociation || lost_.empty()) return;
+void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, FrameResult* result) {
   // Candidates: projecting far enough inside the image for a whole window and onto valid
   // pixels (not under the mask, not in a highlight), grouped by the keyframe of their patch.
   const double margin = frontend_.klt.window_px / 2 + 1;
-  const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
   std::map<const ImagePyramid*, std::vector<std::pair<PointId, Eigen::Vector2d>>> groups;
   for (const auto& [id, lost] : lost_) {
     const auto pixel = camera_.Project(cam_from_world_ * map_->point(id).position);
@@ -290,7 +283,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
   // Regularised pairs: each point's best D edges to other tracked points, each pair once.
   struct Pair {
     size_t i, j;
-    double rest_length, weight;
+    double rest_length, viscous_multiplier;
   };
   std::vector<Pair> pairs;
   std::set<std::pair<size_t, size_t>> seen;
@@ -300,7 +293,8 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
       const auto j = index.find(neighbour.id);
       const auto key = std::minmax(i, j->second);
       if (!seen.insert(key).second) continue;
-      pairs.push_back({key.first, key.second, map_->graph().edge(neighbour.edge).rest_length, neighbour.weight});
+      pairs.push_back({key.first, key.second, map_->graph().edge(neighbour.edge).rest_length,
+                       ViscousMultiplier(deformation_, neighbour.weight, map_->scale())});
     }
   }
 
@@ -338,7 +332,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
           new ceres::HuberLoss(deformation_.huber_deformation), delta_i, delta_j);
       // An outlier's motion is not evidence for its neighbours': its viscous terms go too.
       if ((*inliers)[pair.i] && (*inliers)[pair.j] && viscous_on[p]) {
-        problem.AddResidualBlock(ViscousCost::Create(ViscousMultiplier(deformation_, pair.weight, map_->scale())),
+        problem.AddResidualBlock(ViscousCost::Create(pair.viscous_multiplier),
                                  new ceres::HuberLoss(deformation_.huber_deformation), delta_i, delta_j);
       }
     }
@@ -353,8 +347,8 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
     const double viscous_chi2 = deformation_.huber_deformation * deformation_.huber_deformation;
     for (size_t p = 0; p < pairs.size(); ++p) {
       const Pair& pair = pairs[p];
-      const double multiplier = ViscousMultiplier(deformation_, pair.weight, map_->scale());
-      viscous_on[p] = (multiplier * ((*displacements)[pair.i] - (*displacements)[pair.j])).squaredNorm() <= viscous_chi2;
+      viscous_on[p] =
+          (pair.viscous_multiplier * ((*displacements)[pair.i] - (*displacements)[pair.j])).squaredNorm() <= viscous_chi2;
     }
   }
   *pose = Rigid3::FromParams(params.data());
@@ -454,11 +448,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   motion_ = pose * cam_from_world_.Inverse();
   cam_from_world_ = pose;
   ForgetLostPoints(frame);
-  Reassociate(*pyramid, grey, mask, &result);
+  // One validity mask per frame, shared by re-association and a reference refresh.
+  const bool refresh = frames_since_keyframe_ + 1 >= options_.keyframe_period;
+  const bool search = options_.reassociation && !lost_.empty();
+  const cv::Mat valid = search || refresh ? BuildValidityMask(grey, mask, frontend_.masks) : cv::Mat();
+  if (search) Reassociate(*pyramid, valid, &result);
   if (static_cast<int>(result.points.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");
   }
-  if (++frames_since_keyframe_ >= options_.keyframe_period) RefreshReference(frame, pyramid, grey, mask);
+  if (++frames_since_keyframe_ >= options_.keyframe_period) RefreshReference(frame, pyramid, valid);
   result.state = state_;
   result.cam_from_world = cam_from_world_;
   result.ms_total = MillisecondsSince(start);

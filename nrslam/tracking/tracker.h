@@ -96,8 +96,8 @@ class Tracker {
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
   int frames_since_keyframe_ = 0;
 
-  void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& grey,
-                        const cv::Mat& mask);
+  // Cuts new reference patches in `keyframe`; `valid` is its validity mask.
+  void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid);
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
@@ -112,7 +112,7 @@ class Tracker {
   // Drops lost points that are too old or that the graph has cut loose.
   void ForgetLostPoints(int frame);
   // Looks for lost points near their projection; found ones become tracks again.
-  void Reassociate(const ImagePyramid& pyramid, const cv::Mat& grey, const cv::Mat& mask, FrameResult* result);
+  void Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, FrameResult* result);
   FrameResult Lost(FrameResult result, const std::string& why);
 };
 

@@ -1,5 +1,6 @@
 #include "nrslam/util/json_options.h"
 
+#include <fstream>
 #include <sstream>
 
 namespace nrslam {
@@ -111,6 +112,16 @@ void ApplyAssignment(Json& config, const std::string& assignment) {
                 Join(LeafPaths(*node), ", "));
   }
   *node = ParseLike(*node, text, path);
+}
+
+Json ReadJsonFile(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  if (!stream) throw Error("cannot open " + file.string());
+  try {
+    return Json::parse(stream);
+  } catch (const Json::exception& e) {
+    throw Error(file.string() + " is not valid JSON (" + e.what() + ")");
+  }
 }
 
 }  // namespace nrslam

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ void RejectUnknownKeys(const Json& given, const Json& reference, const std::stri
 // parsed as the existing value's type (integer, number, bool, string, or a JSON/comma list
 // for arrays). Throws Error with the known keys when the path is unknown.
 void ApplyAssignment(Json& config, const std::string& assignment);
+
+// Parses a JSON file; throws Error "cannot open FILE" or "FILE is not valid JSON (why)".
+Json ReadJsonFile(const std::filesystem::path& file);
 
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
 std::vector<std::string> LeafPaths(const Json& config);
