@@ -21,6 +21,7 @@
 namespace nrslam {
 
 using PointId = int64_t;
+constexpr PointId kNoPoint = -1;  // a 2D track without a map point
 
 struct GraphEdge {
   PointId a = -1, b = -1;

@@ -80,4 +80,22 @@ struct ViscousKeyframeCost {
   }
 };
 
+// Deformable triangulation (mapping): a new point's world positions X_a, X_b in two frames
+// must move like its neighbours did between them: r = c · ((X_b − X_a) − flow), with flow
+// the neighbours' mean motion and c = √N / σ, so r² equals the sum over the N neighbours of
+// ‖(X_b − X_a) − flow_n‖²/σ² up to a constant.
+struct NeighbourFlowCost {
+  Eigen::Vector3d flow;
+  double multiplier;
+
+  template <typename T>
+  bool operator()(const T* x_a, const T* x_b, T* residual) const {
+    for (int a = 0; a < 3; ++a) residual[a] = T(multiplier) * ((x_b[a] - x_a[a]) - T(flow[a]));
+    return true;
+  }
+  static ceres::CostFunction* Create(const Eigen::Vector3d& flow, double multiplier) {
+    return new ceres::AutoDiffCostFunction<NeighbourFlowCost, 3, 3, 3>(new NeighbourFlowCost{flow, multiplier});
+  }
+};
+
 }  // namespace nrslam
