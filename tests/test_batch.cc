@@ -133,10 +133,11 @@ TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
 
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   const auto folder = UniqueTempFolder("batch_broken");
-  // A sequence folder with an incomplete sequence.json, between two good simulated ones.
+  // A sequence folder with an incomplete sequence.json, between two good simulated ones (eight
+  // frames: the map comes from depth).
   WriteFile(folder / "broken" / "sequence.json", R"({"format": "nrslam-sequence"})");
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({
-    "defaults": {"simulate": )") + kTinySimulate + R"(},
+    "defaults": {"init": "depth", "simulate": )") + kTinySimulate + R"(},
     "sequences": [
       {"name": "good", "preset": "sim-1"},
       {"name": "broken", "path": "broken"},
@@ -210,7 +211,9 @@ void WriteHamlynLayout(const std::filesystem::path& folder, int frames) {
 TEST(BatchEvaluation, ImportedDatasetsRunAndAMissingOneIsReported) {
   const auto folder = UniqueTempFolder("batch_import");
   WriteHamlynLayout(folder / "hamlyn" / "rectified01", 8);
+  // Eight frames: too short for a monocular map, so the map comes from the dataset's depth.
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({
+    "defaults": {"init": "depth"},
     "sequences": [
       {"name": "h01", "import": {"format": "hamlyn", "path": "hamlyn/rectified01"}},
       {"name": "h02", "import": {"format": "hamlyn", "path": "hamlyn/rectified02"}}

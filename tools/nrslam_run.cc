@@ -9,14 +9,14 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"Run NR-SLAM over a sequence and write its run folder."};
-  std::string sequence, out, init = "depth";
+  std::string sequence, out, init = nrslam::RunOptions{}.init;
   bool rigid = false, no_mapping = false, quiet = false, print_options = false;
   std::vector<std::string> assignments;
   app.add_option("sequence", sequence, "sequence folder")->required();
   app.add_option("--out", out, "run folder to write")->required();
-  app.add_option("--init", init, "depth (map from the sequence's depth) or monocular")->capture_default_str();
+  app.add_option("--init", init, "monocular (the map from the images: full NR-SLAM) or depth (from the sequence's depth)")->capture_default_str();
   app.add_flag("--rigid", rigid, "rigid baseline: no deformation");
-  app.add_flag("--no-mapping", no_mapping, "tracking only (the paper's Table II experiment; the only mode until mapping lands)");
+  app.add_flag("--no-mapping", no_mapping, "tracking only, no keyframe DBA or new points (the paper's Table II experiment)");
   app.add_option("--set", assignments, "set any option, e.g. --set deformation.k=2 (see --print-options)");
   app.add_flag("--print-options", print_options, "print every option as JSON and exit");
   app.add_flag("--quiet", quiet, "no progress line");
@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     nrslam::SystemOptions options;
     options.run.init = init;
     options.tracking.rigid = rigid;
+    if (no_mapping) options.run.mapping = false;
     options = nrslam::WithAssignments(options, assignments);
     if (print_options) {
       std::cout << nrslam::Json(options).dump(2) << '\n';

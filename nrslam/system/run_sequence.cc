@@ -11,6 +11,8 @@
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
+#include "nrslam/mapping/mapper.h"
+#include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
 
@@ -94,11 +96,17 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::ofstream points_csv = OpenForWriting(out / "points.csv");
   points_csv << "frame,point_id,u,v,z_est,x,y,z,status\n";
   std::ofstream metrics_csv = OpenForWriting(out / "metrics.csv");
-  metrics_csv << "frame,state,points,klt_tracked,outliers,propagated,reassociated,points_without_gt,scale,rmse_mm,ms_klt,ms_pose,"
-                 "ms_deformation,ms_total,note\n";
+  metrics_csv << "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,deformable_candidates,new_points,"
+                 "points_without_gt,scale,rmse_mm,ms_klt,ms_pose,ms_deformation,ms_dba,ms_triangulation,ms_total,note\n";
   std::ofstream log = OpenForWriting(out / "run.log");
 
   Tracker tracker(camera, options.frontend, options.deformation, options.tracking);
+  tracker.EnableCandidates(options.run.mapping);
+  Mapper mapper(camera, options.deformation, options.mapping, options.tracking.rigid);
+  MonocularInitialiser initialiser(camera, options.frontend, options.tracking.max_points, options.initialisation);
+  const bool monocular = options.run.init == "monocular";
+  int maps = 0;  // maps started so far: a monocular run starts a new one after each loss
+  double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
   std::vector<FrameEvaluation> evaluations;
@@ -107,6 +115,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   for (int frame = first; frame < last; ++frame) {
     FrameResult result;
     result.frame = frame;
+    MappingReport mapping;
     cv::Mat depth_mm;
     try {
       const cv::Mat bgr = reader.ReadRgb(frame);
@@ -114,13 +123,37 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (reader.has_depth()) depth_mm = reader.ReadDepthMm(frame);
       if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask);
-        if (result.state == TrackingState::kLost) log << "frame " << frame << ": lost (" << result.note << ")\n";
-      } else if (tracker.state() == TrackingState::kLost && !options.run.reinitialise_after_loss) {
+        if (result.state == TrackingState::kLost) {
+          log << "frame " << frame << ": lost (" << result.note << ")\n";
+        } else if (options.run.mapping) {
+          mapping = mapper.Process(result, bgr, &tracker);
+          result.cam_from_world = tracker.pose();  // the DBA may have refined it
+          if (mapping.new_points > 0) log << "frame " << frame << ": " << mapping.new_points << " new points\n";
+        }
+      } else if (tracker.state() == TrackingState::kLost && !monocular && !options.run.reinitialise_after_loss) {
         result.state = TrackingState::kLost;
         result.note = "lost earlier; not re-initialised (run.reinitialise_after_loss=false)";
+      } else if (monocular) {
+        const auto init_start = std::chrono::steady_clock::now();
+        const InitialisationAttempt attempt = initialiser.Add(frame, bgr, mask);
+        ms_initialisation += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - init_start).count();
+        result.state = tracker.state();
+        result.note = "initialising: " + attempt.note;
+        if (attempt.success) {
+          result = tracker.InitialiseFromSeed(frame, bgr, mask, attempt.map.seed);
+          if (result.state == TrackingState::kTracking) {
+            if (options.run.mapping) mapper.StartMap(result, tracker, ReferenceKeyframe(attempt.map));
+            ++maps;
+            if (summary.init_frame < 0) summary.init_frame = frame;
+            log << "frame " << frame << ": map " << maps << " initialised from frames " << attempt.map.reference_frame
+                << " and " << frame << ": " << attempt.note << "\n";
+          }
+        }
       } else {
         result = tracker.InitialiseFromDepth(frame, bgr, depth_mm, mask);
         if (result.state == TrackingState::kTracking) {
+          if (options.run.mapping) mapper.StartMap(result, tracker, std::nullopt);
+          ++maps;
           if (summary.init_frame < 0) summary.init_frame = frame;
           log << "frame " << frame << ": map initialised from depth with " << result.points.size() << " points\n";
         }
@@ -131,6 +164,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       log << "frame " << frame << ": " << e.what() << '\n';
     }
 
+    ms_tracking += result.ms_total;
+    ms_dba += mapping.ms_dba;
+    ms_triangulation += mapping.ms_triangulation;
     FrameEvaluation evaluation;
     std::vector<DepthPoint> depth_points;
     const bool tracked = result.state == TrackingState::kTracking;
@@ -157,12 +193,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     } else if (summary.init_frame >= 0) {
       ++summary.frames_lost;
     }
-    metrics_csv << frame << ',' << ToString(result.state) << ',' << result.points.size() << ',' << result.klt_tracked
-                << ',' << result.outliers << ',' << result.propagated << ',' << result.reassociated << ','
-                << evaluation.points_without_groundtruth << ','
-                << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
+    metrics_csv << frame << ',' << ToString(result.state) << ',' << maps << ',' << result.points.size() << ','
+                << result.klt_tracked << ',' << result.candidates.size() << ',' << result.outliers << ','
+                << result.propagated << ',' << result.reassociated << ',' << mapping.rigid_candidates << ','
+                << mapping.deformable_candidates << ',' << mapping.new_points << ','
+                << evaluation.points_without_groundtruth << ',' << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
                 << (evaluation.evaluated ? std::to_string(evaluation.rmse_mm) : std::string()) << ','
-                << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << result.ms_total
+                << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
+                << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation
                 << ",\"" << result.note << "\"\n";
     if (progress) {
       std::ostringstream line;
@@ -175,6 +213,12 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.fps = summary.frames_total / std::max(seconds, 1e-9);
+  summary.ms_initialisation = ms_initialisation / summary.frames_total;
+  summary.ms_tracking = ms_tracking / summary.frames_total;
+  summary.ms_dba = ms_dba / summary.frames_total;
+  summary.ms_triangulation = ms_triangulation / summary.frames_total;
+  summary.maps = maps;
+  summary.map_points = tracker.map().size();
   const SequenceMetrics metrics = AggregateFrames(evaluations);
   summary.rmse_mm = metrics.rmse_mm;
   summary.rmse_median_mm = metrics.rmse_median_mm;
@@ -193,6 +237,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                                  {"frames_evaluated", summary.frames_evaluated},
                                  {"init_frame", summary.init_frame},
                                  {"fps", summary.fps},
+                                 {"ms_per_frame", {{"initialisation", summary.ms_initialisation},
+                                                   {"tracking", summary.ms_tracking},
+                                                   {"dba", summary.ms_dba},
+                                                   {"triangulation", summary.ms_triangulation}}},
+                                 {"maps", summary.maps},
+                                 {"map_points", summary.map_points},
+                                 {"init", options.run.init},
+                                 {"mapping", options.run.mapping},
                                  {"mode", options.tracking.rigid ? "rigid" : "deformable"},
                                  {"status", summary.init_frame < 0 ? "not_initialised" : "ok"}}
                       .dump(2)

@@ -6,7 +6,7 @@
 //                   16-bit in the sequence's depth unit, 0 = none
 //   metrics.csv     per frame: state, points, outliers, scale, RMSE, ms per stage
 //   summary.json    rmse_mm, rmse_median_mm, rmse_pooled_mm, frames_tracked, frames_total,
-//                   init_frame, fps, and the run's status
+//                   init_frame, fps, ms per stage, maps, map_points and the run's status
 //   map.ply         the final map points, coloured
 //   run.log         what happened, in words
 #pragma once
@@ -27,6 +27,10 @@ struct RunSummary {
   int init_frame = -1;
   int frames_evaluated = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)
+  // Mean milliseconds per processed frame in each stage (the mapping stages run on some frames only).
+  double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
+  int maps = 0;            // maps started (a monocular run starts a new one after a loss)
+  size_t map_points = 0;   // points in the last map
 };
 
 using RunProgress = std::function<void(int frame, int total, const std::string& line)>;

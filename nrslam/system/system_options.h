@@ -8,16 +8,20 @@
 #include "nrslam/deformation/deformation_options.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/frontend/frontend_options.h"
+#include "nrslam/mapping/mapping_options.h"
 #include "nrslam/tracking/tracking_options.h"
 
 namespace nrslam {
 
 struct RunOptions {
-  std::string init = "depth";  // "depth": the first frame's map from the sequence's depth
-  bool mapping = false;        // DBA and new points (not available yet)
-  bool reinitialise_after_loss = false;  // with --init depth this rebuilds the map from ground truth,
-                                        // which would flatter a method that loses track: off, as in the
-                                        // paper's tracking experiment (frames after a loss count as lost)
+  std::string init = "monocular";  // "monocular": the map from the images alone (essential matrix),
+                                   // the full NR-SLAM; "depth": the first frame's map from the
+                                   // sequence's depth (the paper's tracking experiment)
+  bool mapping = true;             // keyframes, DBA and new points; false = tracking only
+  // Only for --init depth, where it would rebuild the map from ground truth and flatter a
+  // method that loses track: off, as in the paper's tracking experiment (frames after a loss
+  // count as lost). A monocular run always re-initialises from the images after a loss.
+  bool reinitialise_after_loss = false;
   int first_frame = 0;         // frame range to process, [first_frame, last_frame); -1 = to the end
   int last_frame = -1;
   std::string camera;          // a camera JSON (as in sequence.json) used instead of the sequence's; "" = its own
@@ -31,15 +35,20 @@ struct SystemOptions {
   FrontendOptions frontend;
   DeformationModelOptions deformation;
   TrackingOptions tracking;
+  InitialisationOptions initialisation;
+  MappingOptions mapping;
   EvaluationOptions evaluation;
   void Check() const {
     run.Check();
     frontend.Check();
     deformation.Check();
     tracking.Check();
+    initialisation.Check();
+    mapping.Check();
     evaluation.Check();
   }
 };
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SystemOptions, run, frontend, deformation, tracking, evaluation)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SystemOptions, run, frontend, deformation, tracking, initialisation,
+                                                mapping, evaluation)
 
 }  // namespace nrslam

@@ -84,33 +84,24 @@ FrameResult Tracker::Lost(FrameResult result, const std::string& why) {
 }
 
 FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv::Mat& depth_mm, const cv::Mat& mask) {
-  const auto start = Clock::now();
-  FrameResult result;
-  result.frame = frame;
   const cv::Mat grey = Grey(bgr);
   FeatureOptions features = frontend_.features;
   features.max_features = options_.max_points;
-  const std::vector<cv::Point2f> corners =
-      DetectCorners(grey, BuildValidityMask(grey, mask, frontend_.masks), {}, features);
-  map_ = std::make_unique<Map>(deformation_);
-  tracks_.clear();
-  lost_.clear();
+  MapSeed seed;
   std::vector<double> depths;
-  std::vector<PointId> ids;
-  for (const cv::Point2f& corner : corners) {
+  for (const cv::Point2f& corner : DetectCorners(grey, BuildValidityMask(grey, mask, frontend_.masks), {}, features)) {
     const auto depth = SampleDepth(depth_mm, cv::Point2d(corner.x, corner.y));
     if (!depth) continue;
     const Eigen::Vector3d bearing = camera_.Unproject(Eigen::Vector2d(corner.x, corner.y));
     if (bearing.z() <= 1e-6) continue;
-    const Eigen::Vector3d point = bearing * (*depth / bearing.z());
-    const PointId id = map_->AddPoint(point, bgr.at<cv::Vec3b>(cvRound(corner.y), cvRound(corner.x)), frame);
-    ids.push_back(id);
+    seed.pixels.push_back(corner);
+    seed.points.push_back(bearing * (*depth / bearing.z()));
     depths.push_back(*depth);
-    tracks_.push_back({id, corner, true, {}});
   }
-  if (static_cast<int>(ids.size()) < options_.min_points) {
-    tracks_.clear();
-    return Lost(result, "too few points with depth to initialise (" + std::to_string(ids.size()) + ")");
+  if (static_cast<int>(depths.size()) < options_.min_points) {
+    FrameResult result;
+    result.frame = frame;
+    return Lost(result, "too few points with depth to initialise (" + std::to_string(depths.size()) + ")");
   }
   double mean = 0, squares = 0;
   for (double z : depths) {
@@ -118,13 +109,36 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
     squares += z * z;
   }
   mean /= depths.size();
-  const double deviation = std::sqrt(std::max(1e-12, squares / depths.size() - mean * mean));
+  seed.depth_deviation = std::sqrt(std::max(1e-12, squares / depths.size() - mean * mean));
   std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  map_->set_scale(depths[depths.size() / 2] / 3.0);
-  map_->graph().set_sigma(deformation_.sigma_factor * deviation);
-  map_->graph().ConnectCovisible(ids, {}, map_->Positions());
+  seed.scale = depths[depths.size() / 2] / 3.0;
+  return InitialiseFromSeed(frame, bgr, mask, seed);
+}
 
-  cam_from_world_ = Rigid3();
+FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv::Mat& mask, const MapSeed& seed) {
+  const auto start = Clock::now();
+  FrameResult result;
+  result.frame = frame;
+  map_ = std::make_unique<Map>(deformation_);
+  tracks_.clear();
+  lost_.clear();
+  if (static_cast<int>(seed.points.size()) < options_.min_points) {
+    return Lost(result, "too few points to start a map (" + std::to_string(seed.points.size()) + ")");
+  }
+  const cv::Mat grey = Grey(bgr);
+  std::map<int, std::vector<PointId>> groups;
+  for (size_t i = 0; i < seed.points.size(); ++i) {
+    const cv::Point2f& pixel = seed.pixels[i];
+    const cv::Point pixel_int(std::clamp(cvRound(pixel.x), 0, bgr.cols - 1), std::clamp(cvRound(pixel.y), 0, bgr.rows - 1));
+    const PointId id = map_->AddPoint(seed.points[i], bgr.at<cv::Vec3b>(pixel_int), frame);
+    groups[seed.groups.empty() ? 0 : seed.groups[i]].push_back(id);
+    tracks_.push_back({id, next_track_id_++, pixel, true, {}});
+  }
+  map_->set_scale(seed.scale);
+  map_->graph().set_sigma(deformation_.sigma_factor * seed.depth_deviation);
+  for (const auto& [group, ids] : groups) map_->graph().ConnectCovisible(ids, {}, map_->Positions());
+
+  cam_from_world_ = seed.cam_from_world;
   motion_ = Rigid3();
   RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels),
                    BuildValidityMask(grey, mask, frontend_.masks));
@@ -139,13 +153,34 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
   return result;
 }
 
-void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid) {
+void Tracker::PromoteCandidate(int track_id, PointId id) {
+  for (PointTrack& track : tracks_) {
+    if (track.track_id == track_id && track.id == kNoPoint) {
+      track.id = id;
+      return;
+    }
+  }
+}
+
+void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid,
+                               const cv::Mat& grey) {
   std::vector<PointTrack> active;
   std::vector<cv::Point2f> pixels;
   for (const PointTrack& track : tracks_) {
     if (!track.active) continue;
     active.push_back(track);
     pixels.push_back(track.pixel);
+  }
+  if (candidates_ && !grey.empty()) {
+    FeatureOptions features = frontend_.features;
+    features.max_features = std::max(0, frontend_.features.max_features - static_cast<int>(pixels.size()));
+    if (features.max_features > 0) {
+      for (const cv::Point2f& corner : DetectCorners(grey, valid, pixels, features)) {
+        active.push_back({kNoPoint, next_track_id_++, corner, true, {}});
+      }
+      pixels.clear();
+      for (const PointTrack& track : active) pixels.push_back(track.pixel);
+    }
   }
   tracks_ = std::move(active);
   klt_.SetReference(*keyframe, pixels, valid);
@@ -161,7 +196,7 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
 
 void Tracker::LoseTrack(PointTrack* track, int frame) {
   track->active = false;
-  if (!track->patch.keyframe) return;
+  if (!track->patch.keyframe || track->id == kNoPoint) return;
   if (!options_.rigid && map_->graph().IsWeaklyConnected(track->id)) return;
   lost_[track->id] = {track->patch, frame};
 }
@@ -228,7 +263,7 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
       const PointId id = candidates[i].first;
       const PatchSource patch = lost_.at(id).patch;
       klt_.Append(*patch.keyframe, {patch.pixel});
-      tracks_.push_back({id, found[i].position, klt_.has_reference(klt_.size() - 1), patch});
+      tracks_.push_back({id, next_track_id_++, found[i].position, klt_.has_reference(klt_.size() - 1), patch});
       lost_.erase(id);
       if (!tracks_.back().active) continue;
       result->points.push_back({id, found[i].position, true});
@@ -377,6 +412,10 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
       continue;
     }
     tracks_[i].pixel = matches[i].position;
+    if (tracks_[i].id == kNoPoint) {
+      result.candidates.push_back({tracks_[i].track_id, tracks_[i].pixel});
+      continue;
+    }
     observations.push_back({i, tracks_[i].id, Eigen::Vector2d(matches[i].position.x, matches[i].position.y)});
   }
   result.klt_tracked = static_cast<int>(observations.size());
@@ -413,6 +452,14 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     std::sort(sorted.begin(), sorted.end());
     const double q1 = sorted[sorted.size() / 4], q3 = sorted[(3 * sorted.size()) / 4];
     const double fence = q3 + options_.displacement_iqr_factor * (q3 - q1);
+    std::vector<double> inlier_norms;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (inliers[i]) inlier_norms.push_back(norms[i]);
+    }
+    if (!inlier_norms.empty()) {
+      std::nth_element(inlier_norms.begin(), inlier_norms.begin() + inlier_norms.size() / 2, inlier_norms.end());
+      result.median_displacement = inlier_norms[inlier_norms.size() / 2];
+    }
     for (size_t i = 0; i < observations.size(); ++i) {
       demoted[i] = norms[i] >= fence && norms[i] > 0;
       if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
@@ -456,7 +503,14 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   if (static_cast<int>(result.points.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");
   }
-  if (++frames_since_keyframe_ >= options_.keyframe_period) RefreshReference(frame, pyramid, valid);
+  if (++frames_since_keyframe_ >= options_.keyframe_period) {
+    RefreshReference(frame, pyramid, valid, grey);
+    result.keyframe = true;
+    result.candidates.clear();  // the refresh may have dropped some and added new ones
+    for (const PointTrack& track : tracks_) {
+      if (track.active && track.id == kNoPoint) result.candidates.push_back({track.track_id, track.pixel});
+    }
+  }
   result.state = state_;
   result.cam_from_world = cam_from_world_;
   result.ms_total = MillisecondsSince(start);

@@ -35,17 +35,36 @@ struct TrackedPoint {
   bool reassociated = false;  // found again this frame by mid-term re-association
 };
 
+// A 2D track with no 3D point yet: a candidate for triangulation (mapping).
+struct CandidateObservation {
+  int track_id;
+  cv::Point2f pixel;
+};
+
 struct FrameResult {
   int frame = 0;
   TrackingState state = TrackingState::kNotInitialised;
   Rigid3 cam_from_world;
   std::vector<TrackedPoint> points;  // 3D points tracked and kept this frame
+  std::vector<CandidateObservation> candidates;  // 2D-only tracks followed this frame
+  bool keyframe = false;             // reference patches were refreshed on this frame
+  double median_displacement = 0;    // median ‖δ‖ of the optimised points, map units (0 when rigid)
   int klt_tracked = 0;               // tracks the KLT kept
   int outliers = 0;                  // demoted by the optimisation this frame
   int propagated = 0;                // lost or demoted points moved with their neighbours
   int reassociated = 0;              // lost points found again
   double ms_klt = 0, ms_pose = 0, ms_deformation = 0, ms_total = 0;
   std::string note;                  // why a frame is not tracked
+};
+
+// The map a tracker starts from: 3D points (world) seen at pixels of the start frame.
+struct MapSeed {
+  Rigid3 cam_from_world;             // the start frame's camera
+  std::vector<cv::Point2f> pixels;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> groups;           // graph groups: edges join points of one group (empty = one group)
+  double scale = 1.0;                // Map::scale
+  double depth_deviation = 0.0;      // std of the points' depths, map units: σ = sigma_factor · this
 };
 
 class Tracker {
@@ -56,10 +75,22 @@ class Tracker {
   // Builds the map from a depth map (mm) of this frame: corners in the valid area, lifted to
   // 3D, joined in a complete graph; σ = sigma_factor · std(depth). The frame's pose is the world.
   FrameResult InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv::Mat& depth_mm, const cv::Mat& mask);
+  // Starts a new map from `seed` (e.g. a monocular initialisation) on this frame. Seed point
+  // i becomes map point i.
+  FrameResult InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv::Mat& mask, const MapSeed& seed);
   FrameResult Track(int frame, const cv::Mat& bgr, const cv::Mat& mask);
 
+  // With candidates on, each keyframe adds new corners as 2D tracks for mapping to triangulate.
+  void EnableCandidates(bool on) { candidates_ = on; }
+  // The 2D track `track_id` now observes map point `id` (just triangulated).
+  void PromoteCandidate(int track_id, PointId id);
+  // Mapping's refined estimate of the current camera (e.g. after DBA).
+  void SetPose(const Rigid3& cam_from_world) { cam_from_world_ = cam_from_world; }
+
   TrackingState state() const { return state_; }
+  const Rigid3& pose() const { return cam_from_world_; }
   const Map& map() const { return *map_; }
+  Map& mutable_map() { return *map_; }
 
  private:
   // Where a track's KLT reference patch was cut: a keyframe and the point's pixel there.
@@ -68,7 +99,8 @@ class Tracker {
     cv::Point2f pixel;
   };
   struct PointTrack {
-    PointId id;
+    PointId id;        // kNoPoint for a candidate (2D only)
+    int track_id;
     cv::Point2f pixel;
     bool active;
     PatchSource patch;
@@ -95,9 +127,13 @@ class Tracker {
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
   int frames_since_keyframe_ = 0;
+  bool candidates_ = false;
+  int next_track_id_ = 0;
 
-  // Cuts new reference patches in `keyframe`; `valid` is its validity mask.
-  void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid);
+  // Cuts new reference patches in `keyframe`; `valid` is its validity mask. With candidates
+  // on and a grey image given, new corners away from every track join as candidates.
+  void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid,
+                        const cv::Mat& grey = {});
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.

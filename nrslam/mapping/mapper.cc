@@ -1,0 +1,296 @@
+#include "nrslam/mapping/mapper.h"
+
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "nrslam/camera/reprojection_cost.h"
+#include "nrslam/deformation/regularizer_costs.h"
+#include "nrslam/geometry/two_view.h"
+
+namespace nrslam {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+Eigen::Vector2d ToEigen(const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y); }
+
+double SquaredReprojection(const Camera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& world,
+                           const Eigen::Vector2d& observed) {
+  const auto pixel = camera.Project(cam_from_world * world);
+  return pixel ? (*pixel - observed).squaredNorm() : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+Mapper::Mapper(const Camera& camera, const DeformationModelOptions& deformation, const MappingOptions& options,
+               bool rigid)
+    : camera_(camera), deformation_(deformation), options_(options), rigid_(rigid) {
+  options_.Check();
+}
+
+Keyframe Mapper::MakeKeyframe(const FrameResult& result, const Tracker& tracker) const {
+  Keyframe keyframe;
+  keyframe.frame = result.frame;
+  keyframe.cam_from_world = result.cam_from_world;
+  for (const TrackedPoint& point : result.points) {
+    keyframe.ids.push_back(point.id);
+    keyframe.pixels.push_back(ToEigen(point.pixel));
+    keyframe.positions.push_back(tracker.map().point(point.id).position);
+  }
+  return keyframe;
+}
+
+void Mapper::Record(const FrameResult& result, const Tracker& tracker) {
+  Snapshot snapshot;
+  snapshot.frame = result.frame;
+  snapshot.cam_from_world = result.cam_from_world;
+  snapshot.median_displacement = result.median_displacement;
+  for (const TrackedPoint& point : result.points) {
+    snapshot.points.emplace(point.id, std::make_pair(point.pixel, tracker.map().point(point.id).position));
+  }
+  for (const CandidateObservation& candidate : result.candidates) snapshot.candidates.emplace(candidate.track_id, candidate.pixel);
+  buffer_.push_back(std::move(snapshot));
+  while (static_cast<int>(buffer_.size()) > options_.temporal_window + 1) buffer_.pop_front();
+}
+
+void Mapper::StartMap(const FrameResult& start, const Tracker& tracker, const std::optional<Keyframe>& reference) {
+  buffer_.clear();
+  keyframes_.clear();
+  if (reference) keyframes_.push_back(*reference);
+  keyframes_.push_back(MakeKeyframe(start, tracker));
+  Record(start, tracker);
+}
+
+MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker) {
+  MappingReport report;
+  Record(result, *tracker);
+  if (result.keyframe) {
+    keyframes_.push_back(MakeKeyframe(result, *tracker));
+    while (static_cast<int>(keyframes_.size()) > options_.dba_window) keyframes_.pop_front();
+    if (options_.dba && static_cast<int>(keyframes_.size()) >= options_.dba_min_keyframes) RunDba(tracker, &report);
+  } else {
+    Triangulate(result, bgr, tracker, &report);
+  }
+  return report;
+}
+
+void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Keyframe*> window;
+  for (Keyframe& keyframe : keyframes_) window.push_back(&keyframe);
+  Map& map = tracker->mutable_map();
+  report->dba_report =
+      DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(), options_.dba_iterations, rigid_, window);
+  report->dba = true;
+  // The newest keyframe is this frame: its shape and pose are what tracking goes on from.
+  const Keyframe& newest = keyframes_.back();
+  Snapshot& snapshot = buffer_.back();
+  for (size_t i = 0; i < newest.ids.size(); ++i) {
+    map.point(newest.ids[i]).position = newest.positions[i];
+    snapshot.points.at(newest.ids[i]).second = newest.positions[i];
+  }
+  snapshot.cam_from_world = newest.cam_from_world;
+  tracker->SetPose(newest.cam_from_world);
+  report->ms_dba = MillisecondsSince(start);
+}
+
+std::optional<Eigen::Vector3d> Mapper::TriangulateRigid(const CandidateTrack& track, double map_scale) const {
+  const Snapshot& first = *track.frames.front();
+  const Snapshot& last = *track.frames.back();
+  for (const Snapshot& snapshot : buffer_) {
+    if (snapshot.frame >= first.frame && snapshot.frame <= last.frame &&
+        snapshot.median_displacement > options_.rigidity_threshold * map_scale) {
+      return std::nullopt;  // the tissue moved in between: two rays would not meet on it
+    }
+  }
+  const Eigen::Vector3d ray0 = first.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.front()).normalized();
+  const Eigen::Vector3d ray1 = last.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.back()).normalized();
+  const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, ray0,
+                                         last.cam_from_world.Inverse().translation, ray1);
+  const double pixel_angle = 1.0 / camera_.MeanFocal();
+  if (!point || point->depth0 <= 0 || point->depth1 <= 0 ||
+      point->parallax_rad < options_.rigid_min_parallax_px * pixel_angle ||
+      point->parallax_rad > options_.rigid_max_parallax_px * pixel_angle) {
+    return std::nullopt;
+  }
+  if (SquaredReprojection(camera_, first.cam_from_world, point->point, track.pixels.front()) > options_.max_reprojection_px2 ||
+      SquaredReprojection(camera_, last.cam_from_world, point->point, track.pixels.back()) > options_.max_reprojection_px2) {
+    return std::nullopt;
+  }
+  return point->point;
+}
+
+std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrack& track,
+                                                             const std::vector<PointId>& neighbours,
+                                                             double map_scale) const {
+  const size_t n = track.frames.size();
+  // Gate: the two-view rigid solution must be plausible and have some parallax.
+  {
+    const Snapshot& first = *track.frames.front();
+    const Snapshot& last = *track.frames.back();
+    const Eigen::Vector3d ray0 = first.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.front()).normalized();
+    const Eigen::Vector3d ray1 = last.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.back()).normalized();
+    const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, ray0,
+                                           last.cam_from_world.Inverse().translation, ray1);
+    if (!point || point->depth0 <= 0 || point->depth1 <= 0 ||
+        point->parallax_rad < options_.deformable_min_parallax_px / camera_.MeanFocal() ||
+        SquaredReprojection(camera_, first.cam_from_world, point->point, track.pixels.front()) > options_.max_reprojection_px2 ||
+        SquaredReprojection(camera_, last.cam_from_world, point->point, track.pixels.back()) > options_.max_reprojection_px2) {
+      return std::nullopt;
+    }
+  }
+  // Seed: each frame's ray at the mean distance of the neighbours seen in that frame.
+  std::vector<Eigen::Vector3d> positions(n);
+  std::vector<PoseParams> poses(n);
+  for (size_t f = 0; f < n; ++f) {
+    const Snapshot& snapshot = *track.frames[f];
+    double distance = 0;
+    int count = 0;
+    for (PointId id : neighbours) {
+      const auto it = snapshot.points.find(id);
+      if (it == snapshot.points.end()) continue;
+      distance += (snapshot.cam_from_world * it->second.second).norm();
+      ++count;
+    }
+    if (count == 0) return std::nullopt;
+    const Eigen::Vector3d in_camera = camera_.Unproject(track.pixels[f]).normalized() * (distance / count);
+    positions[f] = snapshot.cam_from_world.Inverse() * in_camera;
+    poses[f] = snapshot.cam_from_world.ToParams();
+  }
+
+  ceres::Problem problem;
+  for (size_t f = 0; f < n; ++f) {
+    problem.AddParameterBlock(poses[f].data(), kPoseParams);
+    problem.SetParameterBlockConstant(poses[f].data());
+    problem.AddResidualBlock(CreateReprojectionCost(camera_, track.pixels[f], deformation_.reprojection_sigma_px), nullptr,
+                             poses[f].data(), positions[f].data());
+  }
+  // Neighbour flows between consecutive observations (the reference uses every pair of
+  // frames: O(L²) terms that say the same thing once the consecutive ones hold).
+  const double flow_sigma = options_.flow_sigma * map_scale;
+  std::vector<std::vector<Eigen::Vector3d>> flows(n);
+  for (size_t f = 0; f + 1 < n; ++f) {
+    const Snapshot& a = *track.frames[f];
+    const Snapshot& b = *track.frames[f + 1];
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (PointId id : neighbours) {
+      const auto in_a = a.points.find(id);
+      const auto in_b = b.points.find(id);
+      if (in_a == a.points.end() || in_b == b.points.end()) continue;
+      flows[f].push_back(in_b->second.second - in_a->second.second);
+      mean += flows[f].back();
+    }
+    if (flows[f].empty()) continue;
+    mean /= flows[f].size();
+    problem.AddResidualBlock(NeighbourFlowCost::Create(mean, std::sqrt(flows[f].size()) / flow_sigma), nullptr,
+                             positions[f].data(), positions[f + 1].data());
+  }
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = options_.deformable_iterations;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+
+  int flow_terms = 0, flow_outliers = 0, reprojection_outliers = 0;
+  for (size_t f = 0; f + 1 < n; ++f) {
+    for (const Eigen::Vector3d& flow : flows[f]) {
+      ++flow_terms;
+      const Eigen::Vector3d residual = ((positions[f + 1] - positions[f]) - flow) / flow_sigma;
+      if (residual.squaredNorm() > options_.flow_outlier_chi2) ++flow_outliers;
+    }
+  }
+  const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
+  for (size_t f = 0; f < n; ++f) {
+    if (SquaredReprojection(camera_, track.frames[f]->cam_from_world, positions[f], track.pixels[f]) / sigma2 >
+        options_.reprojection_outlier_chi2) {
+      ++reprojection_outliers;
+    }
+  }
+  if (flow_terms == 0 || 2 * flow_outliers > flow_terms || 2 * reprojection_outliers > static_cast<int>(n)) {
+    return std::nullopt;
+  }
+  // The newest position, put exactly on the newest ray at its optimised distance.
+  const Rigid3& newest = track.frames.back()->cam_from_world;
+  const Eigen::Vector3d ray = camera_.Unproject(track.pixels.back()).normalized();
+  const double along = ray.dot(newest * positions.back());
+  if (!(along > 0) || !positions.back().allFinite()) return std::nullopt;
+  return newest.Inverse() * (ray * along);
+}
+
+void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  if (buffer_.size() < 2 || result.candidates.empty()) return;
+  const Snapshot& newest = buffer_.back();
+  Map& map = tracker->mutable_map();
+  const double crowding2 = options_.crowding_radius_px * options_.crowding_radius_px;
+  const double radius2 = options_.neighbour_radius_px * options_.neighbour_radius_px;
+  std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
+  for (const CandidateObservation& candidate : result.candidates) {
+    // Crowding gate and neighbours: the nearest tracked 3D points in the image.
+    std::vector<std::pair<double, PointId>> near;
+    bool crowded = false;
+    for (const auto& [id, observation] : newest.points) {
+      const cv::Point2f offset = observation.first - candidate.pixel;
+      const double distance2 = offset.dot(offset);
+      if (distance2 < crowding2) {
+        crowded = true;
+        break;
+      }
+      if (distance2 <= radius2) near.emplace_back(distance2, id);
+    }
+    if (crowded || near.empty()) continue;
+    const size_t keep = std::min(near.size(), static_cast<size_t>(options_.neighbours));
+    std::partial_sort(near.begin(), near.begin() + keep, near.end());
+    std::vector<PointId> neighbours;
+    for (size_t i = 0; i < keep; ++i) neighbours.push_back(near[i].second);
+
+    CandidateTrack track;
+    for (const Snapshot& snapshot : buffer_) {
+      const auto it = snapshot.candidates.find(candidate.track_id);
+      if (it == snapshot.candidates.end()) continue;
+      track.frames.push_back(&snapshot);
+      track.pixels.push_back(ToEigen(it->second));
+    }
+    if (track.frames.size() < 2) continue;
+    if (const auto point = TriangulateRigid(track, map.scale())) rigid.emplace_back(candidate.track_id, *point);
+    if (!rigid_ && static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
+      if (const auto point = TriangulateDeformable(track, neighbours, map.scale())) {
+        deformable.emplace_back(candidate.track_id, *point);
+      }
+    }
+  }
+  report->rigid_candidates = static_cast<int>(rigid.size());
+  report->deformable_candidates = static_cast<int>(deformable.size());
+  const double factor = options_.model_selection_factor;
+  const std::vector<std::pair<int, Eigen::Vector3d>>* chosen = nullptr;
+  if (rigid.size() > factor * deformable.size()) {
+    chosen = &rigid;
+  } else if (deformable.size() >= factor * rigid.size()) {
+    chosen = &deformable;
+  }
+  if (chosen && !chosen->empty()) {
+    std::unordered_map<int, cv::Point2f> pixels;
+    for (const CandidateObservation& candidate : result.candidates) pixels.emplace(candidate.track_id, candidate.pixel);
+    std::vector<PointId> created, existing;
+    for (const TrackedPoint& point : result.points) existing.push_back(point.id);
+    for (const auto& [track_id, position] : *chosen) {
+      const cv::Point2f& pixel = pixels.at(track_id);
+      const cv::Point at(std::clamp(cvRound(pixel.x), 0, bgr.cols - 1), std::clamp(cvRound(pixel.y), 0, bgr.rows - 1));
+      const PointId id = map.AddPoint(position, bgr.at<cv::Vec3b>(at), result.frame);
+      created.push_back(id);
+      tracker->PromoteCandidate(track_id, id);
+    }
+    map.graph().ConnectCovisible(created, existing, map.Positions());
+    report->new_points = static_cast<int>(created.size());
+  }
+  report->ms_triangulation = MillisecondsSince(start);
+}
+
+}  // namespace nrslam

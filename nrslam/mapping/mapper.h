@@ -1,0 +1,79 @@
+// mapping: what runs after tracking on each tracked frame (reference-behaviour §1.3, §1.4).
+//
+// Every frame leaves a snapshot in a temporal buffer (pose, median deformation, each tracked
+// 3D point's pixel and world position, each candidate 2D track's pixel). On a keyframe the
+// keyframe is stored and the DBA runs over the window; its newest shape and pose go back to
+// tracking. On other frames candidates are triangulated, rigidly and deformably, and the
+// paper's model selection keeps one set: the rigid points if there are more than
+// model_selection_factor × as many as deformable ones, the deformable points if there are at
+// least that many times more, else none. New points join the DDG, connected to every point
+// tracked this frame, and their 2D tracks become 3D tracks.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <deque>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "nrslam/camera/camera.h"
+#include "nrslam/deformation/deformation_options.h"
+#include "nrslam/mapping/deformable_ba.h"
+#include "nrslam/mapping/mapping_options.h"
+#include "nrslam/tracking/tracker.h"
+
+namespace nrslam {
+
+struct MappingReport {
+  bool dba = false;
+  DbaReport dba_report;
+  int rigid_candidates = 0, deformable_candidates = 0;  // triangulations that passed their checks
+  int new_points = 0;                                   // added this frame (after model selection)
+  double ms_dba = 0, ms_triangulation = 0;
+};
+
+class Mapper {
+ public:
+  Mapper(const Camera& camera, const DeformationModelOptions& deformation, const MappingOptions& options, bool rigid);
+
+  // A new map was started on `start` (the tracker's first frame); `reference`, when given, is
+  // the initialisation's other view (its pixels aligned with the map's first points).
+  void StartMap(const FrameResult& start, const Tracker& tracker, const std::optional<Keyframe>& reference);
+  // After a tracked frame; may change the tracker's map and pose.
+  MappingReport Process(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker);
+
+  const std::deque<Keyframe>& keyframes() const { return keyframes_; }
+
+ private:
+  struct Snapshot {
+    int frame = 0;
+    Rigid3 cam_from_world;
+    double median_displacement = 0;
+    std::unordered_map<PointId, std::pair<cv::Point2f, Eigen::Vector3d>> points;  // pixel, world
+    std::unordered_map<int, cv::Point2f> candidates;                                // track id → pixel
+  };
+  // One candidate track's observations in the buffer, oldest first.
+  struct CandidateTrack {
+    std::vector<const Snapshot*> frames;
+    std::vector<Eigen::Vector2d> pixels;
+  };
+
+  Camera camera_;
+  DeformationModelOptions deformation_;
+  MappingOptions options_;
+  bool rigid_;
+  std::deque<Snapshot> buffer_;
+  std::deque<Keyframe> keyframes_;
+
+  void Record(const FrameResult& result, const Tracker& tracker);
+  Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;
+  void RunDba(Tracker* tracker, MappingReport* report);
+  void Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report);
+  std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, double map_scale) const;
+  std::optional<Eigen::Vector3d> TriangulateDeformable(const CandidateTrack& track,
+                                                       const std::vector<PointId>& neighbours, double map_scale) const;
+};
+
+}  // namespace nrslam

@@ -1,0 +1,35 @@
+#include "nrslam/mapping/mapping_options.h"
+
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+void InitialisationOptions::Check() const {
+  CheckOption(min_tracks >= 8 && min_points >= 8, "initialisation", "min_tracks and min_points must be >= 8");
+  CheckOption(max_reference_age >= 1 && ransac_iterations >= 1, "initialisation",
+              "max_reference_age and ransac_iterations must be >= 1");
+  CheckOption(epipolar_threshold_px > 0 && min_parallax_px >= 0 && max_reprojection_px2 > 0 && median_depth > 0,
+              "initialisation", "thresholds and median_depth must be positive");
+  CheckOption(max_low_parallax_fraction >= 0 && max_low_parallax_fraction <= 1, "initialisation",
+              "max_low_parallax_fraction must be in [0, 1]");
+  CheckOption(initial_graph == "complete" || initial_graph == "flow_clusters", "initialisation",
+              "initial_graph must be complete or flow_clusters, got '" + initial_graph + "'");
+  CheckOption(dbscan_epsilon_px > 0 && dbscan_min_points >= 1, "initialisation", "DBSCAN parameters must be positive");
+}
+
+void MappingOptions::Check() const {
+  CheckOption(dba_window >= 2 && dba_min_keyframes >= 2 && dba_min_keyframes <= dba_window && dba_iterations >= 1,
+              "mapping", "need 2 <= dba_min_keyframes <= dba_window and dba_iterations >= 1");
+  CheckOption(temporal_window >= 2 && neighbours >= 1 && deformable_min_track >= 2 && deformable_iterations >= 1,
+              "mapping", "temporal_window, neighbours, deformable_min_track and iterations out of range");
+  CheckOption(crowding_radius_px >= 0 && neighbour_radius_px > crowding_radius_px, "mapping",
+              "need 0 <= crowding_radius_px < neighbour_radius_px");
+  CheckOption(rigid_min_parallax_px >= 0 && rigid_max_parallax_px > rigid_min_parallax_px, "mapping",
+              "need 0 <= rigid_min_parallax_px < rigid_max_parallax_px");
+  CheckOption(rigidity_threshold >= 0 && max_reprojection_px2 > 0 && flow_sigma > 0 && flow_outlier_chi2 > 0 &&
+                  reprojection_outlier_chi2 > 0 && deformable_min_parallax_px >= 0,
+              "mapping", "thresholds must be positive");
+  CheckOption(model_selection_factor >= 1, "mapping", "model_selection_factor must be >= 1");
+}
+
+}  // namespace nrslam

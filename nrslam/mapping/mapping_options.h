@@ -1,0 +1,67 @@
+// mapping: options of monocular initialisation, DBA and triangulation (reference values:
+// reference-behaviour §3.3, §3.4). Angles given in pixels are multiplied by the camera's
+// angular pixel size 1/f, so one setting fits every resolution.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace nrslam {
+
+struct InitialisationOptions {
+  int min_tracks = 100;              // fewer tracks from the reference frame: restart from this frame
+  int max_reference_age = 30;        // frames; an older reference is replaced by the current frame
+  int ransac_iterations = 200;       // 8-point samples (the reference draws 16 bucketed ones)
+  double epipolar_threshold_px = 2.5;  // E inlier: angle to the epipolar plane, in pixel angles (the reference's 0.005 rad at 0.002 rad/px)
+  double min_parallax_px = 5;        // a point's rays must differ by this many pixel angles
+  double max_reprojection_px2 = 5.991;  // in both views
+  int min_points = 100;              // triangulated points needed to accept
+  double max_low_parallax_fraction = 0.25;  // of the E inliers; more means the baseline is still too short
+  double median_depth = 3.0;         // the map is scaled to this median depth, map units
+  // Initial DDG: "complete" joins every pair of initial points (the reference); "flow_clusters"
+  // joins only points whose optical flow since the reference falls in the same DBSCAN cluster.
+  std::string initial_graph = "complete";
+  double dbscan_epsilon_px = 0.1;    // per flow-vector dimension (the reference's 0.1 × dimension)
+  int dbscan_min_points = 10;
+  void Check() const;
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InitialisationOptions, min_tracks, max_reference_age, ransac_iterations,
+                                                epipolar_threshold_px, min_parallax_px, max_reprojection_px2, min_points,
+                                                max_low_parallax_fraction, median_depth, initial_graph,
+                                                dbscan_epsilon_px, dbscan_min_points)
+
+struct MappingOptions {
+  // Deformable Bundle Adjustment over the last keyframes (a keyframe every
+  // tracking.keyframe_period frames). Gauge: the oldest keyframe's pose is held fixed; the
+  // elastic rest lengths fix the scale.
+  bool dba = true;
+  int dba_window = 5;                // keyframes in the window (paper's N_k)
+  int dba_min_keyframes = 3;         // fewer: no DBA
+  int dba_iterations = 5;            // LM iterations
+  // New points from 2D tracks (corners detected at keyframes) over the last frames.
+  int temporal_window = 20;          // frames of track history kept
+  double crowding_radius_px = 20;    // no new point this close to a tracked 3D point
+  double neighbour_radius_px = 500;  // its neighbours: tracked 3D points within this radius ...
+  int neighbours = 10;               // ... at most this many, nearest first
+  double rigidity_threshold = 0.004; // rigid triangulation needs median ‖δ‖ ≤ this × map scale in every spanned frame
+  double rigid_min_parallax_px = 10; // rigid triangulation: parallax window, in pixel angles
+  double rigid_max_parallax_px = 20;
+  double max_reprojection_px2 = 5.991;  // rigid (both views) and deformable gate
+  int deformable_min_track = 5;      // deformable triangulation needs this many observations
+  double deformable_min_parallax_px = 5;
+  double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
+  int deformable_iterations = 10;
+  double flow_outlier_chi2 = 7.815;  // reject if more than half the flow residuals exceed it ...
+  double reprojection_outlier_chi2 = 59.9;  // ... or more than half the reprojections exceed this
+  double model_selection_factor = 1.5;  // keep a model's points only if it found this many times more
+  void Check() const;
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
+                                                temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
+                                                rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
+                                                max_reprojection_px2, deformable_min_track, deformable_min_parallax_px,
+                                                flow_sigma, deformable_iterations, flow_outlier_chi2,
+                                                reprojection_outlier_chi2, model_selection_factor)
+
+}  // namespace nrslam

@@ -1,0 +1,252 @@
+// Mapping: DBSCAN, the Deformable Bundle Adjustment on synthetic keyframes with a known
+// answer, and monocular initialisation on a simulated colonoscopy against its ground truth,
+// including the reference's compacted-index bug (reference-behaviour §9.2).
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+
+#include "temp_folder.h"
+#include "nrslam/deformation/deformation_graph.h"
+#include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/io/tum.h"
+#include "nrslam/mapping/deformable_ba.h"
+#include "nrslam/mapping/monocular_initialiser.h"
+#include "nrslam/sim/simulate.h"
+#include "nrslam/util/random.h"
+
+namespace nrslam {
+namespace {
+namespace fs = std::filesystem;
+
+TEST(Dbscan, TwoClustersAndNoise) {
+  Eigen::MatrixXd points(25, 2);
+  for (int i = 0; i < 12; ++i) points.row(i) << 0.01 * i, 0.0;           // cluster along x near 0
+  for (int i = 12; i < 24; ++i) points.row(i) << 5.0, 0.01 * (i - 12);  // cluster along y near x = 5
+  points.row(24) << 2.5, 2.5;                                           // alone
+  const std::vector<int> labels = Dbscan(points, 0.05, 3);
+  for (int i = 1; i < 12; ++i) EXPECT_EQ(labels[i], labels[0]);
+  for (int i = 13; i < 24; ++i) EXPECT_EQ(labels[i], labels[12]);
+  EXPECT_NE(labels[0], labels[12]);
+  EXPECT_GE(labels[0], 0);
+  EXPECT_GE(labels[12], 0);
+  EXPECT_EQ(labels[24], -1);
+}
+
+// Four keyframes looking at a rigid patch from a sideways-moving camera: exact pixels, the
+// first pose right, the others and every per-keyframe position perturbed.
+struct DbaScene {
+  Camera camera = Camera::Pinhole(320, 240, 200, 200, 159.5, 119.5);
+  DeformationModelOptions options;
+  std::vector<Eigen::Vector3d> truth;
+  std::vector<Rigid3> poses;
+  std::vector<Keyframe> keyframes;
+  DeformationGraph graph{options};
+
+  DbaScene() {
+    Rng rng(11);
+    for (int i = 0; i < 60; ++i) truth.emplace_back(rng.Uniform(-1.5, 1.5), rng.Uniform(-1, 1), 4 + rng.Uniform(-0.3, 0.3));
+    for (int k = 0; k < 4; ++k) poses.push_back(Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.02 * k, Eigen::Vector3d::UnitY())),
+                                                       Eigen::Vector3d(-0.15 * k, 0.02 * k, 0)));
+    graph.set_sigma(3.0);
+    std::vector<PointId> ids;
+    for (int i = 0; i < 60; ++i) ids.push_back(i);
+    graph.ConnectCovisible(ids, {}, [&](PointId id) -> std::optional<Eigen::Vector3d> { return truth[id]; });
+    for (int k = 0; k < 4; ++k) {
+      Keyframe keyframe;
+      keyframe.frame = 6 * k;
+      keyframe.cam_from_world = poses[k];
+      if (k > 0) {
+        keyframe.cam_from_world = Rigid3(poses[k].rotation * Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitX())),
+                                         poses[k].translation + Eigen::Vector3d(0.03, -0.02, 0.05));
+      }
+      for (int i = 0; i < 60; ++i) {
+        keyframe.ids.push_back(i);
+        keyframe.pixels.push_back(*camera.Project(poses[k] * truth[i]));
+        keyframe.positions.push_back(truth[i] + Eigen::Vector3d(rng.Uniform(-0.05, 0.05), rng.Uniform(-0.05, 0.05),
+                                                                rng.Uniform(-0.1, 0.1)));
+      }
+      keyframes.push_back(keyframe);
+    }
+  }
+  std::vector<Keyframe*> Window() {
+    std::vector<Keyframe*> window;
+    for (Keyframe& keyframe : keyframes) window.push_back(&keyframe);
+    return window;
+  }
+  // Mean |d − d0| / d0 over every pair of points, per keyframe.
+  double MeanStrain() const {
+    double sum = 0;
+    int count = 0;
+    for (const Keyframe& keyframe : keyframes) {
+      for (int i = 0; i < 60; ++i) {
+        for (int j = i + 1; j < 60; ++j) {
+          const double rest = (truth[i] - truth[j]).norm();
+          sum += std::abs((keyframe.positions[i] - keyframe.positions[j]).norm() - rest) / rest;
+          ++count;
+        }
+      }
+    }
+    return sum / count;
+  }
+  double MaxReprojectionPx() const {
+    double worst = 0;
+    for (const Keyframe& keyframe : keyframes) {
+      for (size_t i = 0; i < keyframe.ids.size(); ++i) {
+        worst = std::max(worst, (*camera.Project(keyframe.cam_from_world * keyframe.positions[i]) - keyframe.pixels[i]).norm());
+      }
+    }
+    return worst;
+  }
+};
+
+TEST(DeformableBundleAdjustment, RestoresEachKeyframesShapeAndKeepsTheOldestPoseFixed) {
+  // Each keyframe's shape and pose share a rigid-motion ambiguity (the viscous terms see only
+  // relative motion), so the known answer is the shape — edge lengths back at their rest
+  // lengths — with every observation reprojected, not the poses themselves.
+  DbaScene scene;
+  const double strain_before = scene.MeanStrain();
+  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, scene.graph, 1.0, 30, false, scene.Window());
+  EXPECT_EQ(report.keyframes, 4);
+  EXPECT_EQ(report.points, 60);
+  EXPECT_LT(report.final_cost, 0.01 * report.initial_cost);
+  EXPECT_LT(scene.MaxReprojectionPx(), 0.5);
+  EXPECT_LT(scene.MeanStrain(), 0.1 * strain_before);
+  EXPECT_LT(scene.keyframes.front().cam_from_world.translation.norm(), 1e-12);
+  EXPECT_LT(scene.keyframes.front().cam_from_world.rotation.angularDistance(Eigen::Quaterniond::Identity()), 1e-12);
+  // The oldest keyframe's pose is right and fixed, so its shape is the true one.
+  double first_error = 0;
+  for (int i = 0; i < 60; ++i) first_error += (scene.keyframes[0].positions[i] - scene.truth[i]).norm() / 60;
+  EXPECT_LT(first_error, 0.01);
+}
+
+TEST(DeformableBundleAdjustment, RigidModeSharesOnePositionPerPoint) {
+  DbaScene scene;
+  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, scene.graph, 1.0, 30, true, scene.Window());
+  EXPECT_LT(report.final_cost, 0.01 * report.initial_cost);
+  EXPECT_LT(scene.MaxReprojectionPx(), 0.5);
+  for (int i = 0; i < 60; ++i) {
+    EXPECT_EQ(scene.keyframes[0].positions[i], scene.keyframes[3].positions[i]) << i;
+  }
+}
+
+class MonocularInitialiserTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    folder_ = new fs::path(UniqueTempFolder("nrslam_mapping_test"));
+    fs::remove_all(*folder_);
+    SimOptions sim = SimPreset("sim-0");
+    sim.frames = 31;
+    sim.camera.width = 320;
+    sim.camera.height = 240;
+    SimulateSequence(sim, "sim-0-small", *folder_);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*folder_);
+    delete folder_;
+  }
+
+  // Feeds frames until the initialiser succeeds; `spoil_mask` may change each frame's mask first.
+  static InitialisationAttempt Initialise(int* frame, const std::function<void(int, cv::Mat&)>& spoil_mask = {}) {
+    const SequenceReader reader(*folder_);
+    // 320x240 has about a quarter of the corners of 640x480: the count thresholds scale down.
+    InitialisationOptions options;
+    options.min_tracks = 50;
+    options.min_points = 50;
+    MonocularInitialiser initialiser(reader.info().camera, FrontendOptions{}, 600, options);
+    for (*frame = 0; *frame < reader.frame_count(); ++*frame) {
+      const cv::Mat bgr = reader.ReadRgb(*frame);
+      cv::Mat mask = reader.ReadMask(*frame);
+      if (mask.empty()) mask = cv::Mat(bgr.size(), CV_8UC1, cv::Scalar(255));
+      if (spoil_mask) spoil_mask(*frame, mask);
+      InitialisationAttempt attempt = initialiser.Add(*frame, bgr, mask);
+      if (attempt.success) return attempt;
+    }
+    return {};
+  }
+  // Depth RMSE (mm, scale fitted) of the initial points in the frame the map was made on;
+  // with `flat`, of the same points all at one depth (what a map without structure scores).
+  static FrameEvaluation Evaluate(const InitialMap& map, int frame, bool flat = false) {
+    const SequenceReader reader(*folder_);
+    std::vector<DepthPoint> points;
+    for (size_t i = 0; i < map.seed.points.size(); ++i) {
+      const double z = flat ? 1.0 : (map.seed.cam_from_world * map.seed.points[i]).z();
+      points.push_back({cv::Point2d(map.seed.pixels[i].x, map.seed.pixels[i].y), z});
+    }
+    return EvaluateFrame(points, reader.ReadDepthMm(frame), EvaluationOptions{});
+  }
+  static fs::path* folder_;
+};
+fs::path* MonocularInitialiserTest::folder_ = nullptr;
+
+TEST_F(MonocularInitialiserTest, BuildsAScaledMapThatMatchesTheGroundTruth) {
+  int frame = -1;
+  const InitialisationAttempt attempt = Initialise(&frame);
+  ASSERT_TRUE(attempt.success);
+  EXPECT_LE(frame, 30);
+  EXPECT_EQ(attempt.map.reference_frame, 0);
+  EXPECT_GE(attempt.map.seed.points.size(), 50u);
+  // Scaled so that the median reference depth is 3.
+  std::vector<double> depths;
+  for (const auto& p : attempt.map.seed.points) depths.push_back(p.z());
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  EXPECT_NEAR(depths[depths.size() / 2], 3.0, 1e-9);
+  const FrameEvaluation evaluation = Evaluate(attempt.map, frame);
+  ASSERT_TRUE(evaluation.evaluated);
+  const double flat = Evaluate(attempt.map, frame, true).rmse_mm;
+  std::cout << "initialised on frame " << frame << " with " << attempt.map.seed.points.size() << " points, depth RMSE "
+            << evaluation.rmse_mm << " mm (a flat map: " << flat << " mm)\n";
+  // Measured: 2.0 mm against 8.7 mm for the flat map (4.1 mm without the pose refinement).
+  EXPECT_LT(evaluation.rmse_mm, 0.5 * flat);
+}
+
+TEST_F(MonocularInitialiserTest, PairsStayAlignedWhenReferenceCornersAreLost) {
+  // From the second frame on, the sequence's mask hides the left third, which drops the tracks
+  // there. The reference read pixels from the full list with indices of the compacted one
+  // (§9.2), pairing the reference pixel of one point with the current pixel of another. sim-0
+  // is rigid, so the ground truth says exactly where each reference pixel must be now.
+  int frame = -1;
+  const auto hide_left = [](int index, cv::Mat& mask) {
+    if (index > 0) mask(cv::Rect(0, 0, mask.cols / 3, mask.rows)).setTo(0);
+  };
+  const InitialisationAttempt attempt = Initialise(&frame, hide_left);
+  ASSERT_TRUE(attempt.success);
+  const InitialMap& map = attempt.map;
+  for (const cv::Point2f& pixel : map.seed.pixels) EXPECT_GE(pixel.x, 320 / 3);
+
+  const SequenceReader reader(*folder_);
+  const std::vector<StampedPose> truth = ReadTum(*folder_ / "groundtruth.tum");
+  const Rigid3 current_from_reference =
+      truth[frame].world_from_camera.Inverse() * truth[map.reference_frame].world_from_camera;
+  const cv::Mat depth = reader.ReadDepthMm(map.reference_frame);
+  std::vector<double> errors;
+  for (size_t i = 0; i < map.reference_pixels.size(); ++i) {
+    const cv::Point2f& r = map.reference_pixels[i];
+    const float z = depth.at<float>(cvRound(r.y), cvRound(r.x));
+    if (z <= 0) continue;
+    const Eigen::Vector3d ray = reader.info().camera.Unproject(Eigen::Vector2d(r.x, r.y));
+    const auto expected = reader.info().camera.Project(current_from_reference * (ray * (z / ray.z())));
+    ASSERT_TRUE(expected);
+    errors.push_back((*expected - Eigen::Vector2d(map.seed.pixels[i].x, map.seed.pixels[i].y)).norm());
+  }
+  ASSERT_GE(errors.size(), 40u);
+  std::sort(errors.begin(), errors.end());
+  std::cout << "with the left third masked: frame " << frame << ", " << map.seed.points.size()
+            << " points, pair error median " << errors[errors.size() / 2] << " px, 3rd quartile "
+            << errors[errors.size() * 3 / 4] << " px\n";
+  // Mis-paired corners are tens of pixels apart, and with the reference's bug every pair after
+  // the first dropped track is mis-paired. Aligned pairs err by KLT noise and depth rounding,
+  // except a few tracks on fold edges (measured: median 0.35 px, 42 of 52 under 1.5 px; the
+  // unmasked map has a few such tracks too).
+  EXPECT_LT(errors[errors.size() / 2], 0.5);
+  EXPECT_LT(errors[errors.size() * 3 / 4], 2.0);
+  // And the map still has structure: better than all points at one depth.
+  EXPECT_LT(Evaluate(map, frame).rmse_mm, Evaluate(map, frame, true).rmse_mm);
+}
+
+}  // namespace
+}  // namespace nrslam
