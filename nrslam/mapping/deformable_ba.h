@@ -11,7 +11,10 @@
 // Gauge: the oldest keyframe's pose is held fixed (the reference leaves all 7 gauge
 // freedoms to LM damping). Scale needs no anchor: the elastic rest lengths fix it; in rigid
 // mode the fixed pose and the previous map set it, and LM's damping keeps it there.
-// Solver: sparse normal Cholesky (SuiteSparse), which exploits the block sparsity.
+// Solver: CGNR (conjugate gradients on the normal equations, block-Jacobi preconditioned),
+// which only multiplies by the sparse Jacobian. Measured per DBA on sim-0 (640x480, 5
+// keyframes): 180 ms, against 527 ms for SuiteSparse sparse normal Cholesky and 866 ms for
+// Eigen's: the per-keyframe positions make the Cholesky factor fill in.
 #pragma once
 
 #include <Eigen/Core>

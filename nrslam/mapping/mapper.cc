@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
@@ -259,9 +260,24 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
       track.pixels.push_back(ToEigen(it->second));
     }
     if (track.frames.size() < 2) continue;
-    if (const auto point = TriangulateRigid(track, map.scale())) rigid.emplace_back(candidate.track_id, *point);
+    // A new point lies on the surface its neighbours span: its depth now is within
+    // max_depth_ratio of theirs. Low parallax leaves a triangulated depth free to run off
+    // (measured on lap-lobes: points at 4 % of the median depth, which then drag the map).
+    double nearest = std::numeric_limits<double>::infinity(), farthest = 0;
+    for (PointId id : neighbours) {
+      const double z = (newest.cam_from_world * newest.points.at(id).second).z();
+      nearest = std::min(nearest, z);
+      farthest = std::max(farthest, z);
+    }
+    const auto plausible = [&](const Eigen::Vector3d& point) {
+      const double z = (newest.cam_from_world * point).z();
+      return z * options_.max_depth_ratio >= nearest && z <= options_.max_depth_ratio * farthest;
+    };
+    if (const auto point = TriangulateRigid(track, map.scale()); point && plausible(*point)) {
+      rigid.emplace_back(candidate.track_id, *point);
+    }
     if (!rigid_ && static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-      if (const auto point = TriangulateDeformable(track, neighbours, map.scale())) {
+      if (const auto point = TriangulateDeformable(track, neighbours, map.scale()); point && plausible(*point)) {
         deformable.emplace_back(candidate.track_id, *point);
       }
     }

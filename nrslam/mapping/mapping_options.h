@@ -44,6 +44,7 @@ struct MappingOptions {
   double crowding_radius_px = 20;    // no new point this close to a tracked 3D point
   double neighbour_radius_px = 500;  // its neighbours: tracked 3D points within this radius ...
   int neighbours = 10;               // ... at most this many, nearest first
+  double max_depth_ratio = 2.0;      // a new point's depth within [nearest/r, r·farthest] of its neighbours'
   double rigidity_threshold = 0.004; // rigid triangulation needs median ‖δ‖ ≤ this × map scale in every spanned frame
   double rigid_min_parallax_px = 10; // rigid triangulation: parallax window, in pixel angles
   double rigid_max_parallax_px = 20;
@@ -59,7 +60,7 @@ struct MappingOptions {
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
-                                                rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
+                                                max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_min_track, deformable_min_parallax_px,
                                                 flow_sigma, deformable_iterations, flow_outlier_chi2,
                                                 reprojection_outlier_chi2, model_selection_factor)
