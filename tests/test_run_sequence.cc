@@ -2,6 +2,8 @@
 // deformable tracking), checked against the simulator's ground truth.
 #include <gtest/gtest.h>
 
+#include <opencv2/videoio.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -10,6 +12,7 @@
 #include <sstream>
 
 #include "temp_folder.h"
+#include "nrslam/datasets/dataset_import.h"
 #include "nrslam/deformation/deformation_graph.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/io/sequence_reader.h"
@@ -193,6 +196,37 @@ TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
   const MonocularOutcome outcome = RunMonocular("sim-3", SystemOptions{});
   ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
   EXPECT_GE(outcome.new_points, 20);
+}
+
+// A plain video with a calibration and nothing else (no depth, no poses) runs end to end:
+// initialised from the images, tracked, with nothing to evaluate.
+TEST(MonocularRun, PlainVideoWithoutGroundTruth) {
+  const fs::path folder = UniqueTempFolder("nrslam_plain_video");
+  fs::remove_all(folder);
+  SimulateSmall("sim-0", 40, 320, 240, folder / "sim");
+  const SequenceReader simulated(folder / "sim");
+  {
+    cv::VideoWriter video((folder / "clip.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30,
+                          cv::Size(320, 240));
+    ASSERT_TRUE(video.isOpened());
+    for (int i = 0; i < simulated.frame_count(); ++i) video.write(simulated.ReadRgb(i));
+  }
+  std::ofstream(folder / "camera.json") << nlohmann::json(simulated.info().camera).dump();
+  ImportOptions import;
+  import.format = "images";
+  import.input = folder / "clip.avi";
+  import.calibration = folder / "camera.json";
+  ImportDataset(import, folder / "video");
+  SystemOptions options;
+  options.initialisation.min_tracks = 50;  // 320x240: about a quarter of 640x480's corners
+  options.initialisation.min_points = 50;
+  const RunSummary summary = RunSequence(folder / "video", options, folder / "run");
+  EXPECT_GE(summary.init_frame, 1);
+  EXPECT_LE(summary.init_frame, 30);
+  EXPECT_EQ(summary.frames_tracked, 40 - summary.init_frame);
+  EXPECT_EQ(summary.frames_evaluated, 0);
+  EXPECT_EQ(ReadTum(folder / "run" / "trajectory.tum").size(), static_cast<size_t>(summary.frames_tracked));
+  fs::remove_all(folder);
 }
 
 // run.camera replaces the sequence's calibration (e.g. a better one than the dataset's); it
