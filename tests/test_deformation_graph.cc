@@ -120,6 +120,24 @@ TEST(DeformationGraph, WeightFollowsTheLongestLengthEverSeen) {
   EXPECT_TRUE(graph.edge(0).pruned);
 }
 
+TEST(DeformationGraph, ResettingTheRestShapeTouchesOnlyEdgesAmongTheGivenPoints) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 2.0);
+  Positions positions;
+  positions.at = {{1, {0, 0, 0}}, {2, {1, 0, 0}}, {3, {0, 2, 0}}};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  positions.at[2] = {3, 0, 0};  // re-estimated structure: 1–2 is now 3 long, 2–3 √13
+  positions.at[3] = {0, 4, 0};  // 3 is not reset: its edges keep their lengths
+  graph.ResetRestShape({1, 2}, positions.Lookup());
+  const GraphEdge& reset = graph.edge(*graph.FindEdge(1, 2));
+  EXPECT_DOUBLE_EQ(reset.rest_length, 3.0);
+  EXPECT_DOUBLE_EQ(reset.min_length, 3.0);
+  EXPECT_DOUBLE_EQ(reset.max_length, 3.0);
+  EXPECT_DOUBLE_EQ(reset.weight, std::exp(-9.0 / 8.0));
+  EXPECT_DOUBLE_EQ(graph.edge(*graph.FindEdge(1, 3)).rest_length, 2.0);
+  EXPECT_DOUBLE_EQ(graph.edge(*graph.FindEdge(2, 3)).rest_length, std::sqrt(5.0));
+}
+
 TEST(DeformationGraph, FlagsPointsLeftWithTooFewEdges) {
   DeformationModelOptions options;
   options.min_good_edges = 2;

@@ -1,5 +1,7 @@
 #include "nrslam/deformation/deformation_graph.h"
 
+#include <unordered_set>
+
 #include <algorithm>
 #include <cmath>
 
@@ -82,6 +84,26 @@ void DeformationGraph::UpdatePoint(PointId point, const PositionLookup& position
     edge.max_length = std::max(edge.max_length, length);
     edge.weight = WeightOf(edge.max_length);
     if ((edge.max_length - edge.min_length) / edge.min_length > options_.stretch_threshold) edge.pruned = true;
+  }
+}
+
+void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const PositionLookup& position) {
+  const std::unordered_set<PointId> chosen(points.begin(), points.end());
+  for (PointId point : points) {
+    const auto list = adjacency_.find(point);
+    const auto here = position(point);
+    if (list == adjacency_.end() || !here) continue;
+    for (int index : list->second) {
+      GraphEdge& edge = edges_[index];
+      const PointId other = edge.a == point ? edge.b : edge.a;
+      if (other < point && chosen.count(other)) continue;  // done from the other end
+      if (!chosen.count(other)) continue;
+      const auto there = position(other);
+      if (!there) continue;
+      const double length = (*here - *there).norm();
+      edge.rest_length = edge.min_length = edge.max_length = length;
+      edge.weight = WeightOf(length);
+    }
   }
 }
 

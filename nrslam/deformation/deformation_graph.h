@@ -59,6 +59,10 @@ class DeformationGraph {
   // Neighbours without a position keep their edge untouched.
   void UpdatePoint(PointId point, const PositionLookup& position);
 
+  // Takes the current lengths of the edges among `points` as their rest lengths (and d_min,
+  // d_max): for a map whose structure was re-estimated, not deformed.
+  void ResetRestShape(const std::vector<PointId>& points, const PositionLookup& position);
+
   // Up to max_degree_D unpruned edges with b >= min_edge_weight, highest b first, to
   // neighbours that pass `eligible` (all if empty): e.g. only the points tracked this frame,
   // so lost neighbours do not use up the point's D regularisers.

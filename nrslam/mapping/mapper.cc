@@ -65,6 +65,7 @@ void Mapper::StartMap(const FrameResult& start, const Tracker& tracker, const st
   keyframes_.clear();
   if (reference) keyframes_.push_back(*reference);
   keyframes_.push_back(MakeKeyframe(start, tracker));
+  map_keyframes_ = static_cast<int>(keyframes_.size());
   Record(start, tracker);
 }
 
@@ -73,6 +74,7 @@ MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tra
   Record(result, *tracker);
   if (result.keyframe) {
     keyframes_.push_back(MakeKeyframe(result, *tracker));
+    ++map_keyframes_;
     while (static_cast<int>(keyframes_.size()) > options_.dba_window) keyframes_.pop_front();
     if (options_.dba && static_cast<int>(keyframes_.size()) >= options_.dba_min_keyframes) RunDba(tracker, &report);
   } else {
@@ -86,11 +88,21 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
   std::vector<Keyframe*> window;
   for (Keyframe& keyframe : keyframes_) window.push_back(&keyframe);
   Map& map = tracker->mutable_map();
-  report->dba_report =
-      DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(), options_.dba_iterations, rigid_, window);
+  const bool warmup = map_keyframes_ <= options_.rigid_warmup_keyframes;
+  report->dba_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
+                                                  options_.dba_iterations, rigid_ || warmup, window);
   report->dba = true;
   // The newest keyframe is this frame: its shape and pose are what tracking goes on from.
   const Keyframe& newest = keyframes_.back();
+  if (warmup && !rigid_) {
+    std::unordered_map<PointId, Eigen::Vector3d> shape;
+    for (size_t i = 0; i < newest.ids.size(); ++i) shape[newest.ids[i]] = newest.positions[i];
+    map.graph().ResetRestShape(newest.ids, [&](PointId id) -> std::optional<Eigen::Vector3d> {
+      const auto it = shape.find(id);
+      if (it == shape.end()) return std::nullopt;
+      return it->second;
+    });
+  }
   Snapshot& snapshot = buffer_.back();
   for (size_t i = 0; i < newest.ids.size(); ++i) {
     map.point(newest.ids[i]).position = newest.positions[i];

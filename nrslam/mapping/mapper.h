@@ -66,6 +66,7 @@ class Mapper {
   bool rigid_;
   std::deque<Snapshot> buffer_;
   std::deque<Keyframe> keyframes_;
+  int map_keyframes_ = 0;  // keyframes made since the map started
 
   void Record(const FrameResult& result, const Tracker& tracker);
   Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;

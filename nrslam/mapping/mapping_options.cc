@@ -29,6 +29,7 @@ void MappingOptions::Check() const {
   CheckOption(rigidity_threshold >= 0 && max_reprojection_px2 > 0 && flow_sigma > 0 && flow_outlier_chi2 > 0 &&
                   reprojection_outlier_chi2 > 0 && deformable_min_parallax_px >= 0,
               "mapping", "thresholds must be positive");
+  CheckOption(rigid_warmup_keyframes >= 0, "mapping", "rigid_warmup_keyframes must be >= 0");
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
   CheckOption(model_selection_factor >= 1, "mapping", "model_selection_factor must be >= 1");
 }

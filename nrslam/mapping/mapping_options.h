@@ -39,6 +39,11 @@ struct MappingOptions {
   int dba_window = 5;                // keyframes in the window (paper's N_k)
   int dba_min_keyframes = 3;         // fewer: no DBA
   int dba_iterations = 5;            // LM iterations
+  // The first keyframes of a map are adjusted rigidly and their shape becomes the DDG's rest
+  // shape: the two-view map's depths get corrected by the growing baseline before the
+  // per-keyframe shapes can absorb their error (counting the initial two). 0 = off (the
+  // reference); 4 measured best of 0, 4, 6, 8, 12 on the suite (README, "Mapping").
+  int rigid_warmup_keyframes = 4;
   // New points from 2D tracks (corners detected at keyframes) over the last frames.
   int temporal_window = 20;          // frames of track history kept
   double crowding_radius_px = 20;    // no new point this close to a tracked 3D point
@@ -59,6 +64,7 @@ struct MappingOptions {
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
+                                                rigid_warmup_keyframes,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_min_track, deformable_min_parallax_px,
