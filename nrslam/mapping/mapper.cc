@@ -288,7 +288,8 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
     if (const auto point = TriangulateRigid(track, map.scale()); point && plausible(*point)) {
       rigid.emplace_back(candidate.track_id, *point);
     }
-    if (!rigid_ && static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
+    if (!rigid_ && options_.deformable_triangulation &&
+        static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
       if (const auto point = TriangulateDeformable(track, neighbours, map.scale()); point && plausible(*point)) {
         deformable.emplace_back(candidate.track_id, *point);
       }

@@ -54,6 +54,11 @@ struct MappingOptions {
   double rigid_min_parallax_px = 10; // rigid triangulation: parallax window, in pixel angles
   double rigid_max_parallax_px = 20;
   double max_reprojection_px2 = 5.991;  // rigid (both views) and deformable gate
+  // Deformable triangulation and the paper's model selection between it and rigid
+  // triangulation. Without it a deforming scene gets almost no new points (the rigidity
+  // gate) and is lost once the camera leaves the initial map; with it the map keeps growing,
+  // at a cost in accuracy over short runs (README, "Mapping").
+  bool deformable_triangulation = true;
   int deformable_min_track = 5;      // deformable triangulation needs this many observations
   double deformable_min_parallax_px = 5;
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
@@ -67,7 +72,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window,
                                                 rigid_warmup_keyframes,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
-                                                max_reprojection_px2, deformable_min_track, deformable_min_parallax_px,
+                                                max_reprojection_px2, deformable_triangulation, deformable_min_track, deformable_min_parallax_px,
                                                 flow_sigma, deformable_iterations, flow_outlier_chi2,
                                                 reprojection_outlier_chi2, model_selection_factor)
 
