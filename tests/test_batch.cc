@@ -131,6 +131,34 @@ TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
   EXPECT_NE(crash.report.find("FAILED: boom"), std::string::npos);
 }
 
+// A run without ground truth (a plain video) shows no RMSE rather than a perfect 0.000.
+TEST(Results, RunsWithoutGroundTruthShowNoRmse) {
+  RunResult video;
+  video.sequence = "video";
+  video.status = "ok";
+  video.init_frame = 18;
+  video.frames_tracked = 42;
+  video.frames_total = 60;
+  video.fps = 20;
+  RunResult simulated = video;
+  simulated.sequence = "sim";
+  simulated.frames_evaluated = 42;
+  simulated.rmse_mm = 1.25;
+  simulated.rmse_median_mm = 1.5;
+  std::stringstream table;
+  PrintResults({video, simulated}, table);
+  EXPECT_NE(table.str().find("no GT"), std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("1.250"), std::string::npos) << table.str();
+  EXPECT_EQ(table.str().find("0.000"), std::string::npos) << table.str();
+  const std::vector<RunResult> read = ResultsFromJson(ToJson({video, simulated}));
+  EXPECT_FALSE(read[0].evaluated());
+  EXPECT_EQ(read[1].frames_evaluated, 42);
+  // results.json from before the field: every tracked frame had ground truth.
+  Json old = ToJson({simulated});
+  old["results"][0].erase("frames_evaluated");
+  EXPECT_EQ(ResultsFromJson(old)[0].frames_evaluated, 42);
+}
+
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   const auto folder = UniqueTempFolder("batch_broken");
   // A sequence folder with an incomplete sequence.json, between two good simulated ones (eight

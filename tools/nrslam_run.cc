@@ -36,9 +36,13 @@ int main(int argc, char** argv) {
       if (!quiet && done == total) std::cerr << '\n';
     });
     std::cout << "frames tracked " << summary.frames_tracked << "/" << summary.frames_total << " (init at "
-              << summary.init_frame << ", lost " << summary.frames_lost << ")  RMSE mean " << summary.rmse_mm
-              << " mm, median " << summary.rmse_median_mm << " mm  " << summary.fps << " fps\nrun folder: " << out
-              << '\n';
+              << summary.init_frame << ", lost " << summary.frames_lost << ")  ";
+    if (summary.frames_evaluated > 0) {
+      std::cout << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm  ";
+    } else {
+      std::cout << "no ground truth, no RMSE  ";
+    }
+    std::cout << summary.fps << " fps\nrun folder: " << out << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_run: " << e.what() << '\n';
     return 1;

@@ -111,7 +111,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
     return html.str();
   }
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
-       << FormatFixed(result.rmse_mm, 3) << " mm (median " << FormatFixed(result.rmse_median_mm, 3)
+       << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
        << "), run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
@@ -167,7 +167,7 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   // option → sequence → value → (sum, n): each point averages over the other options' values.
   std::map<std::string, std::map<std::string, std::map<double, std::pair<double, int>>>> curves;
   for (const RunResult& r : results) {
-    if (r.status != "ok") continue;
+    if (r.status != "ok" || !r.evaluated()) continue;
     for (const std::string& assignment : r.point) {
       const size_t equals = assignment.find('=');
       try {
@@ -221,8 +221,8 @@ void WriteReport(const std::vector<RunResult>& results, const std::filesystem::p
       continue;
     }
     html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"
-         << r.frames_total << "</td><td>" << FormatFixed(r.rmse_mm, 3) << "</td><td>"
-         << FormatFixed(r.rmse_median_mm, 3) << "</td><td>" << FormatFixed(r.fps, 1) << "</td></tr>\n";
+         << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
+         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FormatFixed(r.fps, 1) << "</td></tr>\n";
   }
   html << "</table>\n" << SweepSection(results);
   for (const RunResult& r : results) html << RunSection(r, folder);

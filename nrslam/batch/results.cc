@@ -26,12 +26,18 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->init_frame = json.value("init_frame", -1);
   result->frames_tracked = json.value("frames_tracked", 0);
   result->frames_total = json.value("frames_total", 0);
+  // Results written before the field existed always had ground truth for every tracked frame.
+  result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
   result->fps = json.value("fps", 0.0);
 }
 
 }  // namespace
+
+std::string RmseCell(const RunResult& result, double rmse_mm) {
+  return result.evaluated() ? FormatFixed(rmse_mm, 3) : "no GT";
+}
 
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
   std::vector<RunResult> results;
@@ -63,7 +69,7 @@ Json ToJson(const std::vector<RunResult>& results) {
   for (const RunResult& r : results) {
     rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
-                    {"frames_total", r.frames_total}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
+                    {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
                     {"fps", r.fps}, {"run_folder", r.run_folder}});
   }
   return {{"results", rows}};
@@ -93,10 +99,11 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::filesystem::create_directories(folder);
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
-  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,rmse_mm,rmse_median_mm,fps,error\n";
+  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
+         "fps,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
-        << r.frames_tracked << ',' << r.frames_total << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',' << r.fps
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',' << r.fps
         << ',' << CsvField(r.error) << '\n';
   }
 }
@@ -120,7 +127,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     } else {
       row.insert(row.end(), {r.status, std::to_string(r.init_frame),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
-                             FormatFixed(r.rmse_mm, 3), FormatFixed(r.rmse_median_mm, 3), FormatFixed(r.fps, 1)});
+                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), FormatFixed(r.fps, 1)});
     }
     table.AddRow(row);
   }
@@ -133,7 +140,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   // every point of the sweep, so each value is averaged over the same sequences.
   std::map<std::string, bool> complete;  // sequence -> ok at every point
   for (const RunResult& r : results) {
-    const bool ok = r.status == "ok";
+    const bool ok = r.status == "ok" && r.evaluated();
     complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
   }
   // Values in numeric order when they are numbers ("5" before "10"), else as text.

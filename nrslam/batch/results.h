@@ -19,9 +19,14 @@ struct RunResult {
   std::string status = "failed";    // "ok", "lost" (tracking lost before the end) or "failed"
   std::string error;                // why it failed
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
+  int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   std::string run_folder;
+  bool evaluated() const { return frames_evaluated > 0; }
 };
+
+// An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
+std::string RmseCell(const RunResult& result, double rmse_mm);
 
 // Reads each run's summary.json (or failure.json) from its folder.
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan);
