@@ -66,6 +66,7 @@ void Mapper::StartMap(const FrameResult& start, const Tracker& tracker, const st
   if (reference) keyframes_.push_back(*reference);
   keyframes_.push_back(MakeKeyframe(start, tracker));
   map_keyframes_ = static_cast<int>(keyframes_.size());
+  two_view_map_ = reference.has_value();
   Record(start, tracker);
 }
 
@@ -88,7 +89,7 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
   std::vector<Keyframe*> window;
   for (Keyframe& keyframe : keyframes_) window.push_back(&keyframe);
   Map& map = tracker->mutable_map();
-  const bool warmup = map_keyframes_ <= options_.rigid_warmup_keyframes;
+  const bool warmup = two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
   report->dba_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
                                                   options_.dba_iterations, rigid_ || warmup, window);
   report->dba = true;

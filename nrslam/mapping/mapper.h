@@ -67,6 +67,7 @@ class Mapper {
   std::deque<Snapshot> buffer_;
   std::deque<Keyframe> keyframes_;
   int map_keyframes_ = 0;  // keyframes made since the map started
+  bool two_view_map_ = false;  // the map came from monocular initialisation (not from depth)
 
   void Record(const FrameResult& result, const Tracker& tracker);
   Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;

@@ -39,9 +39,10 @@ struct MappingOptions {
   int dba_window = 5;                // keyframes in the window (paper's N_k)
   int dba_min_keyframes = 3;         // fewer: no DBA
   int dba_iterations = 5;            // LM iterations
-  // The first keyframes of a map are adjusted rigidly and their shape becomes the DDG's rest
-  // shape: the two-view map's depths get corrected by the growing baseline before the
-  // per-keyframe shapes can absorb their error (counting the initial two). 0 = off (the
+  // The first keyframes of a two-view map are adjusted rigidly and their shape becomes the
+  // DDG's rest shape: the map's depths get corrected by the growing baseline before the
+  // per-keyframe shapes can absorb their error (counting the initial two). A map from depth
+  // is left alone (warming it up made depth-initialised runs worse). 0 = off (the
   // reference); 4 measured best of 0, 4, 6, 8, 12 on the suite (README, "Mapping").
   int rigid_warmup_keyframes = 4;
   // New points from 2D tracks (corners detected at keyframes) over the last frames.
@@ -49,7 +50,7 @@ struct MappingOptions {
   double crowding_radius_px = 20;    // no new point this close to a tracked 3D point
   double neighbour_radius_px = 500;  // its neighbours: tracked 3D points within this radius ...
   int neighbours = 10;               // ... at most this many, nearest first
-  double max_depth_ratio = 2.0;      // a new point's depth within [nearest/r, r·farthest] of its neighbours'
+  double max_depth_ratio = 1.25;     // a new point's depth within [nearest/r, r·farthest] of its neighbours'
   double rigidity_threshold = 0.004; // rigid triangulation needs median ‖δ‖ ≤ this × map scale in every spanned frame
   double rigid_min_parallax_px = 10; // rigid triangulation: parallax window, in pixel angles
   double rigid_max_parallax_px = 20;
