@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <limits>
 
 #include "nrslam/camera/camera.h"
 #include "nrslam/geometry/rigid3.h"
@@ -75,6 +76,14 @@ struct DeformedReprojectionCost {
 };
 
 // The functors above for the camera's model.
+// Squared pixel distance between `observed` and the projection of `world`; infinite when the
+// point does not project (behind the camera, off the model's domain).
+inline double SquaredReprojectionError(const Camera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& world,
+                                       const Eigen::Vector2d& observed) {
+  const auto pixel = camera.Project(cam_from_world * world);
+  return pixel ? (*pixel - observed).squaredNorm() : std::numeric_limits<double>::infinity();
+}
+
 inline ceres::CostFunction* CreateReprojectionCost(const Camera& camera, const Eigen::Vector2d& observed,
                                                    double sigma_px) {
   return VisitCameraModel(camera.model(), [&](auto model) {

@@ -4,28 +4,17 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
-#include "nrslam/geometry/two_view.h"
+#include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
 namespace {
 
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
 Eigen::Vector2d ToEigen(const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y); }
-
-double SquaredReprojection(const Camera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& world,
-                           const Eigen::Vector2d& observed) {
-  const auto pixel = camera.Project(cam_from_world * world);
-  return pixel ? (*pixel - observed).squaredNorm() : std::numeric_limits<double>::infinity();
-}
 
 }  // namespace
 
@@ -85,7 +74,7 @@ MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tra
 }
 
 void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   std::vector<Keyframe*> window;
   for (Keyframe& keyframe : keyframes_) window.push_back(&keyframe);
   Map& map = tracker->mutable_map();
@@ -95,70 +84,59 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
   report->dba = true;
   // The newest keyframe is this frame: its shape and pose are what tracking goes on from.
   const Keyframe& newest = keyframes_.back();
-  if (warmup && !rigid_) {
-    std::unordered_map<PointId, Eigen::Vector3d> shape;
-    for (size_t i = 0; i < newest.ids.size(); ++i) shape[newest.ids[i]] = newest.positions[i];
-    map.graph().ResetRestShape(newest.ids, [&](PointId id) -> std::optional<Eigen::Vector3d> {
-      const auto it = shape.find(id);
-      if (it == shape.end()) return std::nullopt;
-      return it->second;
-    });
-  }
   Snapshot& snapshot = buffer_.back();
   for (size_t i = 0; i < newest.ids.size(); ++i) {
     map.point(newest.ids[i]).position = newest.positions[i];
     snapshot.points.at(newest.ids[i]).second = newest.positions[i];
   }
+  if (warmup && !rigid_) map.graph().ResetRestShape(newest.ids, map.Positions());
   snapshot.cam_from_world = newest.cam_from_world;
   tracker->SetPose(newest.cam_from_world);
   report->ms_dba = MillisecondsSince(start);
 }
 
-std::optional<Eigen::Vector3d> Mapper::TriangulateRigid(const CandidateTrack& track, double map_scale) const {
+std::optional<Triangulated> Mapper::TriangulateEnds(const CandidateTrack& track) const {
   const Snapshot& first = *track.frames.front();
   const Snapshot& last = *track.frames.back();
-  for (const Snapshot& snapshot : buffer_) {
-    if (snapshot.frame >= first.frame && snapshot.frame <= last.frame &&
-        snapshot.median_displacement > options_.rigidity_threshold * map_scale) {
-      return std::nullopt;  // the tissue moved in between: two rays would not meet on it
-    }
-  }
   const Eigen::Vector3d ray0 = first.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.front()).normalized();
   const Eigen::Vector3d ray1 = last.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.back()).normalized();
   const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, ray0,
                                          last.cam_from_world.Inverse().translation, ray1);
-  const double pixel_angle = 1.0 / camera_.MeanFocal();
   if (!point || point->depth0 <= 0 || point->depth1 <= 0 ||
-      point->parallax_rad < options_.rigid_min_parallax_px * pixel_angle ||
-      point->parallax_rad > options_.rigid_max_parallax_px * pixel_angle) {
+      SquaredReprojectionError(camera_, first.cam_from_world, point->point, track.pixels.front()) >
+          options_.max_reprojection_px2 ||
+      SquaredReprojectionError(camera_, last.cam_from_world, point->point, track.pixels.back()) >
+          options_.max_reprojection_px2) {
     return std::nullopt;
   }
-  if (SquaredReprojection(camera_, first.cam_from_world, point->point, track.pixels.front()) > options_.max_reprojection_px2 ||
-      SquaredReprojection(camera_, last.cam_from_world, point->point, track.pixels.back()) > options_.max_reprojection_px2) {
+  return point;
+}
+
+std::optional<Eigen::Vector3d> Mapper::TriangulateRigid(const CandidateTrack& track,
+                                                        const std::optional<Triangulated>& ends,
+                                                        double map_scale) const {
+  const int first = track.frames.front()->frame, last = track.frames.back()->frame;
+  for (const Snapshot& snapshot : buffer_) {
+    if (snapshot.frame >= first && snapshot.frame <= last &&
+        snapshot.median_displacement > options_.rigidity_threshold * map_scale) {
+      return std::nullopt;  // the tissue moved in between: two rays would not meet on it
+    }
+  }
+  const double pixel_angle = 1.0 / camera_.MeanFocal();
+  if (!ends || ends->parallax_rad < options_.rigid_min_parallax_px * pixel_angle ||
+      ends->parallax_rad > options_.rigid_max_parallax_px * pixel_angle) {
     return std::nullopt;
   }
-  return point->point;
+  return ends->point;
 }
 
 std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrack& track,
+                                                             const std::optional<Triangulated>& ends,
                                                              const std::vector<PointId>& neighbours,
                                                              double map_scale) const {
   const size_t n = track.frames.size();
   // Gate: the two-view rigid solution must be plausible and have some parallax.
-  {
-    const Snapshot& first = *track.frames.front();
-    const Snapshot& last = *track.frames.back();
-    const Eigen::Vector3d ray0 = first.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.front()).normalized();
-    const Eigen::Vector3d ray1 = last.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.back()).normalized();
-    const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, ray0,
-                                           last.cam_from_world.Inverse().translation, ray1);
-    if (!point || point->depth0 <= 0 || point->depth1 <= 0 ||
-        point->parallax_rad < options_.deformable_min_parallax_px / camera_.MeanFocal() ||
-        SquaredReprojection(camera_, first.cam_from_world, point->point, track.pixels.front()) > options_.max_reprojection_px2 ||
-        SquaredReprojection(camera_, last.cam_from_world, point->point, track.pixels.back()) > options_.max_reprojection_px2) {
-      return std::nullopt;
-    }
-  }
+  if (!ends || ends->parallax_rad < options_.deformable_min_parallax_px / camera_.MeanFocal()) return std::nullopt;
   // Seed: each frame's ray at the mean distance of the neighbours seen in that frame.
   std::vector<Eigen::Vector3d> positions(n);
   std::vector<PoseParams> poses(n);
@@ -222,7 +200,7 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrac
   }
   const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
   for (size_t f = 0; f < n; ++f) {
-    if (SquaredReprojection(camera_, track.frames[f]->cam_from_world, positions[f], track.pixels[f]) / sigma2 >
+    if (SquaredReprojectionError(camera_, track.frames[f]->cam_from_world, positions[f], track.pixels[f]) / sigma2 >
         options_.reprojection_outlier_chi2) {
       ++reprojection_outliers;
     }
@@ -239,7 +217,7 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrac
 }
 
 void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   if (buffer_.size() < 2 || result.candidates.empty()) return;
   const Snapshot& newest = buffer_.back();
   Map& map = tracker->mutable_map();
@@ -286,12 +264,13 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
       const double z = (newest.cam_from_world * point).z();
       return z * options_.max_depth_ratio >= nearest && z <= options_.max_depth_ratio * farthest;
     };
-    if (const auto point = TriangulateRigid(track, map.scale()); point && plausible(*point)) {
+    const std::optional<Triangulated> ends = TriangulateEnds(track);
+    if (const auto point = TriangulateRigid(track, ends, map.scale()); point && plausible(*point)) {
       rigid.emplace_back(candidate.track_id, *point);
     }
     if (!rigid_ && options_.deformable_triangulation &&
         static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-      if (const auto point = TriangulateDeformable(track, neighbours, map.scale()); point && plausible(*point)) {
+      if (const auto point = TriangulateDeformable(track, ends, neighbours, map.scale()); point && plausible(*point)) {
         deformable.emplace_back(candidate.track_id, *point);
       }
     }

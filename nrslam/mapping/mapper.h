@@ -20,6 +20,7 @@
 
 #include "nrslam/camera/camera.h"
 #include "nrslam/deformation/deformation_options.h"
+#include "nrslam/geometry/two_view.h"
 #include "nrslam/mapping/deformable_ba.h"
 #include "nrslam/mapping/mapping_options.h"
 #include "nrslam/tracking/tracker.h"
@@ -73,8 +74,14 @@ class Mapper {
   Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;
   void RunDba(Tracker* tracker, MappingReport* report);
   void Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report);
-  std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, double map_scale) const;
+  // The rays of a track's first and last observations met in the middle, if both lie in
+  // front and it reprojects within max_reprojection_px2 in both views: the rigid answer, and
+  // the deformable triangulation's plausibility gate.
+  std::optional<Triangulated> TriangulateEnds(const CandidateTrack& track) const;
+  std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, const std::optional<Triangulated>& ends,
+                                                  double map_scale) const;
   std::optional<Eigen::Vector3d> TriangulateDeformable(const CandidateTrack& track,
+                                                       const std::optional<Triangulated>& ends,
                                                        const std::vector<PointId>& neighbours, double map_scale) const;
 };
 

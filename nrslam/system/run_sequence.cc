@@ -15,6 +15,7 @@
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -109,9 +110,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
+  const auto start_map = [&](const FrameResult& started, const std::optional<Keyframe>& reference) {
+    if (options.run.mapping) mapper.StartMap(started, tracker, reference);
+    ++maps;
+    if (summary.init_frame < 0) summary.init_frame = started.frame;
+  };
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   for (int frame = first; frame < last; ++frame) {
     FrameResult result;
     result.frame = frame;
@@ -134,17 +140,15 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         result.state = TrackingState::kLost;
         result.note = "lost earlier; not re-initialised (run.reinitialise_after_loss=false)";
       } else if (monocular) {
-        const auto init_start = std::chrono::steady_clock::now();
+        const auto init_start = Clock::now();
         const InitialisationAttempt attempt = initialiser.Add(frame, bgr, mask);
-        ms_initialisation += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - init_start).count();
+        ms_initialisation += MillisecondsSince(init_start);
         result.state = tracker.state();
         result.note = "initialising: " + attempt.note;
         if (attempt.success) {
           result = tracker.InitialiseFromSeed(frame, bgr, mask, attempt.map.seed);
           if (result.state == TrackingState::kTracking) {
-            if (options.run.mapping) mapper.StartMap(result, tracker, ReferenceKeyframe(attempt.map));
-            ++maps;
-            if (summary.init_frame < 0) summary.init_frame = frame;
+            start_map(result, ReferenceKeyframe(attempt.map));
             log << "frame " << frame << ": map " << maps << " initialised from frames " << attempt.map.reference_frame
                 << " and " << frame << ": " << attempt.note << "\n";
           }
@@ -152,9 +156,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       } else {
         result = tracker.InitialiseFromDepth(frame, bgr, depth_mm, mask);
         if (result.state == TrackingState::kTracking) {
-          if (options.run.mapping) mapper.StartMap(result, tracker, std::nullopt);
-          ++maps;
-          if (summary.init_frame < 0) summary.init_frame = frame;
+          start_map(result, std::nullopt);
           log << "frame " << frame << ": map initialised from depth with " << result.points.size() << " points\n";
         }
       }
@@ -211,7 +213,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       progress(frame + 1 - first, summary.frames_total, line.str());
     }
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.fps = summary.frames_total / std::max(seconds, 1e-9);
   summary.ms_initialisation = ms_initialisation / summary.frames_total;
   summary.ms_tracking = ms_tracking / summary.frames_total;

@@ -6,7 +6,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <set>
@@ -17,25 +16,15 @@
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
 #include "nrslam/geometry/se3_manifold.h"
+#include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 cv::Mat Grey(const cv::Mat& bgr) {
   cv::Mat grey;
   cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
   return grey;
-}
-
-double SquaredReprojection(const Camera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& point,
-                           const Eigen::Vector2d& observed) {
-  const auto pixel = camera.Project(cam_from_world * point);
-  return pixel ? (*pixel - observed).squaredNorm() : std::numeric_limits<double>::infinity();
 }
 
 ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType solver) {
@@ -299,7 +288,7 @@ std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observatio
     const Rigid3 estimate = Rigid3::FromParams(params.data());
     const double sigma2 = options_.pose_sigma_px * options_.pose_sigma_px;
     for (size_t i = 0; i < observations.size(); ++i) {
-      inliers[i] = SquaredReprojection(camera_, estimate, points[i], observations[i].pixel) / sigma2 <= options_.outlier_chi2;
+      inliers[i] = SquaredReprojectionError(camera_, estimate, points[i], observations[i].pixel) / sigma2 <= options_.outlier_chi2;
     }
   }
   *pose = Rigid3::FromParams(params.data());
@@ -375,7 +364,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
     ceres::Solve(SolverOptions(options_.deformation_iterations, ceres::SPARSE_NORMAL_CHOLESKY), &problem, &summary);
     const Rigid3 estimate = Rigid3::FromParams(params.data());
     for (size_t i = 0; i < n; ++i) {
-      (*inliers)[i] = SquaredReprojection(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
+      (*inliers)[i] = SquaredReprojectionError(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
                           sigma2 <=
                       options_.outlier_chi2;
     }
