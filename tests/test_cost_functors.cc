@@ -58,8 +58,16 @@ TEST(ReprojectionCost, GradientsAtRandomPointsForEveryCameraModel) {
       ExpectGradientsMatch(*cost, {&se3, nullptr}, {pose.data(), point.data()});
 
       Eigen::Vector3d displacement = RandomVector(rng, 0.05);
-      std::unique_ptr<ceres::CostFunction> deformed(CreateDeformedReprojectionCost(camera, observed, 0.5));
-      ExpectGradientsMatch(*deformed, {&se3, nullptr, nullptr}, {pose.data(), point.data(), displacement.data()});
+      std::unique_ptr<ceres::CostFunction> deformed(CreateDeformedReprojectionCost(camera, observed, point, 0.5));
+      ExpectGradientsMatch(*deformed, {&se3, nullptr}, {pose.data(), displacement.data()});
+      // Same residual as the rigid functor at the moved point.
+      Eigen::Vector3d moved = point + displacement;
+      const double* deformed_parameters[2] = {pose.data(), displacement.data()};
+      const double* rigid_parameters[2] = {pose.data(), moved.data()};
+      Eigen::Vector2d deformed_residual, rigid_residual;
+      ASSERT_TRUE(deformed->Evaluate(deformed_parameters, deformed_residual.data(), nullptr));
+      ASSERT_TRUE(cost->Evaluate(rigid_parameters, rigid_residual.data(), nullptr));
+      EXPECT_LT((deformed_residual - rigid_residual).norm(), 1e-9);
     }
   }
 }

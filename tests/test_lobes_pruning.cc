@@ -24,10 +24,10 @@ TEST(LobesPruning, ShortEdgesAcrossTheSeamArePrunedFarMoreThanWithinALobe) {
   RenderedFrame frame = renderer.Render(0);
   ASSERT_EQ(tracker.InitialiseFromDepth(0, frame.left.bgr, frame.left.depth_mm, {}).state, TrackingState::kTracking);
   std::map<PointId, int> surface;
-  for (const auto& [id, point] : tracker.map().points()) {
+  for (const MapPoint& point : tracker.map().points()) {
     const SurfaceHit hit = renderer.caster().Cast(frame.world_from_camera.translation,
                                                   (frame.world_from_camera.rotation * point.position).normalized());
-    surface[id] = hit.valid ? hit.patch : -1;
+    surface[point.id] = hit.valid ? hit.patch : -1;
   }
   // One breathing cycle (ω = 1.6 rad/s: ~118 frames at 30 fps).
   int tracked = 0;

@@ -4,8 +4,9 @@
 // Pose blocks are 7 numbers [qx qy qz qw tx ty tz] (cam_from_world) with Se3Manifold.
 //  - ReprojectionCost (pose, point): rigid pose refinement (point held constant), rigid and
 //    deformable triangulation, and DBA, where `point` is that keyframe's own copy x_i^k.
-//  - DeformedReprojectionCost (pose, point, displacement): deformable tracking, projecting
-//    x_i^{t-1} + δ_i^t with the point held constant.
+//  - DeformedReprojectionCost (pose, displacement): deformable tracking, projecting
+//    x_i^{t-1} + δ_i^t. The previous position x_i^{t-1} is a constant of the functor, not a
+//    parameter block: a constant block would still widen every autodiff jet by 3.
 #pragma once
 
 #include <ceres/autodiff_cost_function.h>
@@ -62,16 +63,18 @@ struct ReprojectionCost {
 template <typename Model>
 struct DeformedReprojectionCost {
   ProjectionResidual<Model> projection;
+  Eigen::Vector3d point;  // x_i^{t-1}
 
   template <typename T>
-  bool operator()(const T* pose, const T* point, const T* displacement, T* residual) const {
-    const Eigen::Matrix<T, 3, 1> moved(point[0] + displacement[0], point[1] + displacement[1],
-                                       point[2] + displacement[2]);
+  bool operator()(const T* pose, const T* displacement, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> moved(T(point.x()) + displacement[0], T(point.y()) + displacement[1],
+                                       T(point.z()) + displacement[2]);
     return projection.Evaluate(pose, moved, residual);
   }
-  static ceres::CostFunction* Create(const Eigen::Vector2d& observed, const Camera& camera, double sigma_px) {
-    return new ceres::AutoDiffCostFunction<DeformedReprojectionCost, 2, kPoseParams, 3, 3>(
-        new DeformedReprojectionCost{ProjectionResidual<Model>(observed, camera.params(), sigma_px)});
+  static ceres::CostFunction* Create(const Eigen::Vector2d& observed, const Eigen::Vector3d& point,
+                                     const Camera& camera, double sigma_px) {
+    return new ceres::AutoDiffCostFunction<DeformedReprojectionCost, 2, kPoseParams, 3>(
+        new DeformedReprojectionCost{ProjectionResidual<Model>(observed, camera.params(), sigma_px), point});
   }
 };
 
@@ -91,9 +94,9 @@ inline ceres::CostFunction* CreateReprojectionCost(const Camera& camera, const E
   });
 }
 inline ceres::CostFunction* CreateDeformedReprojectionCost(const Camera& camera, const Eigen::Vector2d& observed,
-                                                           double sigma_px) {
+                                                           const Eigen::Vector3d& point, double sigma_px) {
   return VisitCameraModel(camera.model(), [&](auto model) {
-    return DeformedReprojectionCost<decltype(model)>::Create(observed, camera, sigma_px);
+    return DeformedReprojectionCost<decltype(model)>::Create(observed, point, camera, sigma_px);
   });
 }
 

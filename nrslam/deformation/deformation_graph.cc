@@ -81,8 +81,10 @@ void DeformationGraph::UpdatePoint(PointId point, const PositionLookup& position
     if (!there) continue;
     const double length = (*here - *there).norm();
     edge.min_length = std::min(edge.min_length, length);
-    edge.max_length = std::max(edge.max_length, length);
-    edge.weight = WeightOf(edge.max_length);
+    if (length > edge.max_length) {  // the weight follows the longest length (an exp: only when it grows)
+      edge.max_length = length;
+      edge.weight = WeightOf(length);
+    }
     if ((edge.max_length - edge.min_length) / edge.min_length > options_.stretch_threshold) edge.pruned = true;
   }
 }

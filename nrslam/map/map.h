@@ -5,7 +5,6 @@
 #include <opencv2/core.hpp>
 
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 #include "nrslam/deformation/deformation_graph.h"
@@ -24,9 +23,10 @@ class Map {
   explicit Map(const DeformationModelOptions& options) : graph_(options) {}
 
   PointId AddPoint(const Eigen::Vector3d& position, const cv::Vec3b& colour, int frame);
-  MapPoint& point(PointId id) { return points_.at(id); }
-  const MapPoint& point(PointId id) const { return points_.at(id); }
-  const std::unordered_map<PointId, MapPoint>& points() const { return points_; }
+  MapPoint& point(PointId id) { return points_.at(static_cast<size_t>(id)); }
+  const MapPoint& point(PointId id) const { return points_.at(static_cast<size_t>(id)); }
+  // Indexed by id: points are never removed, so ids are 0 … size() − 1.
+  const std::vector<MapPoint>& points() const { return points_; }
   size_t size() const { return points_.size(); }
 
   DeformationGraph& graph() { return graph_; }
@@ -40,9 +40,10 @@ class Map {
   void set_scale(double scale) { scale_ = scale; }
 
  private:
-  std::unordered_map<PointId, MapPoint> points_;
+  // A vector, not a hash map: the graph's per-frame edge updates look up hundreds of
+  // thousands of positions by id.
+  std::vector<MapPoint> points_;
   DeformationGraph graph_;
-  PointId next_id_ = 0;
   double scale_ = 1.0;
 };
 

@@ -45,7 +45,7 @@ void WritePly(const fs::path& path, const Map& map) {
   file << "ply\nformat ascii 1.0\nelement vertex " << map.size()
        << "\nproperty float x\nproperty float y\nproperty float z\n"
           "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
-  for (const auto& [id, point] : map.points()) {
+  for (const MapPoint& point : map.points()) {
     file << point.position.x() << ' ' << point.position.y() << ' ' << point.position.z() << ' '
          << int(point.colour[2]) << ' ' << int(point.colour[1]) << ' ' << int(point.colour[0]) << '\n';
   }

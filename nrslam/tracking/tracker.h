@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -143,7 +144,8 @@ class Tracker {
                         std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
   // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
   // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.
-  int PropagateMotion(const std::unordered_map<PointId, Eigen::Vector3d>& optimised,
+  // `optimised` is indexed by point id (nullopt: not optimised this frame).
+  int PropagateMotion(const std::vector<std::optional<Eigen::Vector3d>>& optimised,
                       const std::vector<PointId>& demoted);
   // Drops lost points that are too old or that the graph has cut loose.
   void ForgetLostPoints(int frame);
