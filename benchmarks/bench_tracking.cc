@@ -1,5 +1,6 @@
 // Tracking speed at 640x480: frames per second of tracking alone (rendering excluded) and
-// milliseconds per stage, deformable and rigid, on a few presets. Target: >= 30 fps.
+// milliseconds per stage on a few presets: deformable (sparse Cholesky, the default), deformable
+// with the CGNR joint solver, and rigid. Target: >= 30 fps.
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -15,9 +16,10 @@ int main(int argc, char** argv) {
     nrslam::Renderer renderer(nrslam::SimPreset(preset));
     std::vector<nrslam::RenderedFrame> rendered;
     for (int i = 0; i < frames; ++i) rendered.push_back(renderer.Render(i));
-    for (const bool rigid : {false, true}) {
+    for (const std::string mode : {"deformable", "cgnr", "rigid"}) {
       nrslam::TrackingOptions tracking;
-      tracking.rigid = rigid;
+      tracking.rigid = mode == "rigid";
+      if (mode == "cgnr") tracking.joint_linear_solver = "cgnr";
       nrslam::Tracker tracker(renderer.camera(), nrslam::FrontendOptions{}, nrslam::DeformationModelOptions{}, tracking);
       tracker.InitialiseFromDepth(0, rendered[0].left.bgr, rendered[0].left.depth_mm, {});
       double klt = 0, pose = 0, deformation = 0, total = 0, points = 0;
@@ -33,7 +35,7 @@ int main(int argc, char** argv) {
         ++tracked;
       }
       const double n = std::max(tracked, 1);
-      std::printf("%-8s %-10s %7.1f %8.2f %8.2f %8.2f %8.2f %8.0f\n", preset.c_str(), rigid ? "rigid" : "deformable",
+      std::printf("%-8s %-10s %7.1f %8.2f %8.2f %8.2f %8.2f %8.0f\n", preset.c_str(), mode.c_str(),
                   1000.0 * n / std::max(total, 1e-9), klt / n, pose / n, deformation / n, total / n, points / n);
     }
   }

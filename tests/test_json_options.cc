@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "nrslam/sim/sim_options.h"
+#include "nrslam/tracking/tracking_options.h"
 #include "nrslam/util/json_options.h"
 
 namespace nrslam {
@@ -39,6 +40,13 @@ TEST(JsonOptions, RoundTripKeepsEveryField) {
   options.appearance.noise_sigma = 3.5;
   const SimOptions back = OptionsFromJson<SimOptions>(Json(options), "test");
   EXPECT_EQ(Json(back), Json(options));
+}
+
+TEST(JsonOptions, TrackingLinearSolverIsAChoiceOfTwo) {
+  const TrackingOptions cgnr = WithAssignments(TrackingOptions{}, {"joint_linear_solver=cgnr"});
+  EXPECT_EQ(cgnr.joint_linear_solver, "cgnr");
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(cgnr), "test").joint_linear_solver, "cgnr");
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"joint_linear_solver=qr"}), Error);
 }
 
 }  // namespace

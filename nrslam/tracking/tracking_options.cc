@@ -10,6 +10,8 @@ void TrackingOptions::Check() const {
   CheckOption(min_points >= 3, "tracking", "min_points must be >= 3");
   CheckOption(pose_rounds >= 1 && pose_iterations >= 1 && deformation_rounds >= 1 && deformation_iterations >= 1,
               "tracking", "rounds and iterations must be >= 1");
+  CheckOption(joint_linear_solver == "sparse_cholesky" || joint_linear_solver == "cgnr", "tracking",
+              "joint_linear_solver must be sparse_cholesky or cgnr, got '" + joint_linear_solver + "'");
   CheckOption(pose_sigma_px > 0 && outlier_chi2 > 0 && displacement_iqr_factor > 0, "tracking",
               "sigma, chi2 and IQR factor must be > 0");
   CheckOption(reassociation_levels >= 1 && reassociation_gate_px2 > 0 && lost_max_age_frames >= 1,
