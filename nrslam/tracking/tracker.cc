@@ -327,7 +327,11 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
 
   const PoseParams rigid = pose->ToParams();
   Se3Manifold manifold;
+  // A point the refined pose puts behind the camera (or off the lens) would make every
+  // evaluation of the problem fail, and Ceres would return at once: it starts as an outlier.
   inliers->assign(n, true);
+  const Rigid3 rigid_pose = *pose;
+  for (size_t i = 0; i < n; ++i) (*inliers)[i] = camera_.Project(rigid_pose * points[i]).has_value();
   // A viscous term whose residual ended a round beyond the Huber δ sits the next round out:
   // neighbours that really move apart (strong or discontinuous deformation) stop pulling.
   std::vector<bool> viscous_on(pairs.size(), true);
