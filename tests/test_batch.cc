@@ -83,6 +83,27 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   std::filesystem::remove_all(folder);
 }
 
+// Every shipped manifest of simulated sequences loads and plans with its options validated
+// (the dataset templates name paths on the user's disk and are tested by their importers).
+TEST(Manifest, ShippedSimulationManifestsAreValid) {
+  const auto folder = UniqueTempFolder("shipped_manifests");
+  int checked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(NRSLAM_MANIFEST_DIR)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".json" || name.find("template") != std::string::npos ||
+        name.find("baseline") != std::string::npos) {
+      continue;
+    }
+    SCOPED_TRACE(name);
+    const Manifest manifest = LoadManifest(entry.path());
+    EXPECT_FALSE(manifest.sequences.empty());
+    EXPECT_EQ(PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache").runs.size(), manifest.sequences.size());
+    ++checked;
+  }
+  EXPECT_GE(checked, 4);  // ci-sim, paper-sim, paper-sim-monocular, colon-seeds-monocular
+  std::filesystem::remove_all(folder);
+}
+
 TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
   const auto folder = UniqueTempFolder("sweep_plan");
   const Manifest manifest =
