@@ -35,7 +35,6 @@ ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType sol
   // ~500 parameter blocks: Eigen's simplicial Cholesky factors this 2.4× faster than
   // SuiteSparse's supernodal one (measured on sim-3: 2.4 vs 5.7 ms per iteration).
   options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-  options.preconditioner_type = ceres::JACOBI;  // CGNR's: the blocks of the normal equations' diagonal
   options.logging_type = ceres::SILENT;
   return options;
 }
@@ -330,8 +329,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
   // A point the refined pose puts behind the camera (or off the lens) would make every
   // evaluation of the problem fail, and Ceres would return at once: it starts as an outlier.
   inliers->assign(n, true);
-  const Rigid3 rigid_pose = *pose;
-  for (size_t i = 0; i < n; ++i) (*inliers)[i] = camera_.Project(rigid_pose * points[i]).has_value();
+  for (size_t i = 0; i < n; ++i) (*inliers)[i] = camera_.Project(*pose * points[i]).has_value();
   // A viscous term whose residual ended a round beyond the Huber δ sits the next round out:
   // neighbours that really move apart (strong or discontinuous deformation) stop pulling.
   std::vector<bool> viscous_on(pairs.size(), true);
@@ -354,6 +352,10 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  // Ceres's default preconditioner for CGNR is block Jacobi.
+  const ceres::Solver::Options solver_options = SolverOptions(
+      options_.deformation_iterations,
+      options_.joint_linear_solver == "cgnr" ? ceres::CGNR : ceres::SPARSE_NORMAL_CHOLESKY);
   for (int round = 0; round < options_.deformation_rounds; ++round) {
     params = rigid;  // every round restarts from the rigid pose and δ = 0
     displacements->assign(n, Eigen::Vector3d::Zero());
@@ -377,9 +379,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
       }
     }
     ceres::Solver::Summary summary;
-    const ceres::LinearSolverType solver =
-        options_.joint_linear_solver == "cgnr" ? ceres::CGNR : ceres::SPARSE_NORMAL_CHOLESKY;
-    ceres::Solve(SolverOptions(options_.deformation_iterations, solver), &problem, &summary);
+    ceres::Solve(solver_options, &problem, &summary);
     const Rigid3 estimate = Rigid3::FromParams(params.data());
     for (size_t i = 0; i < n; ++i) {
       (*inliers)[i] = SquaredReprojectionError(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /

@@ -18,7 +18,7 @@ struct TrackingOptions {
   int deformation_rounds = 2;         // joint pose + displacement problem: outlier rounds ...
   int deformation_iterations = 10;    // ... of this many LM iterations each
   // Linear solver of that problem: "sparse_cholesky" (Eigen's simplicial LDLT, exact steps)
-  // or "cgnr" (conjugate gradients, block-Jacobi preconditioned: the tracking solve ~1.6×
+  // or "cgnr" (conjugate gradients, block-Jacobi preconditioned: the deformation stage ~1.35×
   // faster, as accurate when tracking alone, but less accurate with mapping; README "Tracking").
   std::string joint_linear_solver = "sparse_cholesky";
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
