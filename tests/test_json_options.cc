@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "nrslam/mapping/mapping_options.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/tracking/tracking_options.h"
 #include "nrslam/util/json_options.h"
@@ -47,6 +48,15 @@ TEST(JsonOptions, TrackingLinearSolverIsAChoiceOfTwo) {
   EXPECT_EQ(cgnr.joint_linear_solver, "cgnr");
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(cgnr), "test").joint_linear_solver, "cgnr");
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"joint_linear_solver=qr"}), Error);
+}
+
+TEST(JsonOptions, DbaModelSelectionThresholdsAreValidatedAndRoundTrip) {
+  const MappingOptions options = WithAssignments(
+      MappingOptions{}, {"dba_model_selection=false", "rigid_dba_min_inliers=0.99", "rigid_dba_min_baseline=0.5"});
+  EXPECT_FALSE(options.dba_model_selection);
+  EXPECT_EQ(Json(OptionsFromJson<MappingOptions>(Json(options), "test")), Json(options));
+  EXPECT_THROW(WithAssignments(MappingOptions{}, {"rigid_dba_min_inliers=1.5"}), Error);  // a fraction
+  EXPECT_THROW(WithAssignments(MappingOptions{}, {"rigid_dba_min_baseline=-0.1"}), Error);
 }
 
 }  // namespace

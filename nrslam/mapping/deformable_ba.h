@@ -39,6 +39,10 @@ struct Keyframe {
 struct DbaReport {
   int keyframes = 0, points = 0, residual_blocks = 0;
   double initial_cost = 0, final_cost = 0;
+  // Filled by the mapper: which model adjusted the window, and its model-selection statistics
+  // (negative when not measured; mapping.dba_model_selection).
+  bool rigid = false;
+  double baseline_ratio = -1, rigid_inlier_fraction = -1;
 };
 
 // Refines `window` (oldest first) in place; `graph` gives the edges and weights.

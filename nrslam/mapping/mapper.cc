@@ -73,14 +73,68 @@ MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tra
   return report;
 }
 
+namespace {
+
+std::vector<Keyframe*> Pointers(std::deque<Keyframe>* keyframes) {
+  std::vector<Keyframe*> pointers;
+  for (Keyframe& keyframe : *keyframes) pointers.push_back(&keyframe);
+  return pointers;
+}
+
+}  // namespace
+
+double Mapper::InlierFraction(const std::deque<Keyframe>& keyframes) const {
+  int observations = 0, inliers = 0;
+  for (const Keyframe& keyframe : keyframes) {
+    for (size_t i = 0; i < keyframe.ids.size(); ++i, ++observations) {
+      inliers += SquaredReprojectionError(camera_, keyframe.cam_from_world, keyframe.positions[i], keyframe.pixels[i]) <=
+                 options_.max_reprojection_px2;
+    }
+  }
+  return observations > 0 ? static_cast<double>(inliers) / observations : 0.0;
+}
+
+double Mapper::BaselineRatio(const std::deque<Keyframe>& keyframes) const {
+  const Keyframe& newest = keyframes.back();
+  std::vector<double> depths;
+  for (const Eigen::Vector3d& x : newest.positions) depths.push_back((newest.cam_from_world * x).z());
+  if (depths.empty()) return 0;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double travel = (newest.cam_from_world.Inverse().translation -
+                         keyframes.front().cam_from_world.Inverse().translation).norm();
+  return travel / depths[depths.size() / 2];
+}
+
 void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
   const auto start = Clock::now();
-  std::vector<Keyframe*> window;
-  for (Keyframe& keyframe : keyframes_) window.push_back(&keyframe);
   Map& map = tracker->mutable_map();
   const bool warmup = two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
-  report->dba_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
-                                                  options_.dba_iterations, rigid_ || warmup, window);
+  bool rigid_shape = rigid_ || warmup;
+  bool adjusted = false;
+  DbaReport selection;
+  if (!rigid_shape && options_.dba_model_selection) {
+    // The tracked camera travel, before any adjustment: a short baseline leaves a rigid fit
+    // free to turn deformation into depth error, however well it reprojects.
+    selection.baseline_ratio = BaselineRatio(keyframes_);
+    if (selection.baseline_ratio >= options_.rigid_dba_min_baseline) {
+      std::deque<Keyframe> trial = keyframes_;
+      const DbaReport rigid_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
+                                                                options_.dba_iterations, true, Pointers(&trial));
+      selection.rigid_inlier_fraction = InlierFraction(trial);
+      if (selection.rigid_inlier_fraction >= options_.rigid_dba_min_inliers) {
+        keyframes_ = std::move(trial);
+        report->dba_report = rigid_report;
+        rigid_shape = adjusted = true;
+      }
+    }
+  }
+  if (!adjusted) {
+    report->dba_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
+                                                    options_.dba_iterations, rigid_shape, Pointers(&keyframes_));
+  }
+  report->dba_report.rigid = rigid_shape;
+  report->dba_report.baseline_ratio = selection.baseline_ratio;
+  report->dba_report.rigid_inlier_fraction = selection.rigid_inlier_fraction;
   report->dba = true;
   // The newest keyframe is this frame: its shape and pose are what tracking goes on from.
   const Keyframe& newest = keyframes_.back();
@@ -89,7 +143,7 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
     map.point(newest.ids[i]).position = newest.positions[i];
     snapshot.points.at(newest.ids[i]).second = newest.positions[i];
   }
-  if (warmup && !rigid_) map.graph().ResetRestShape(newest.ids, map.Positions());
+  if (rigid_shape && !rigid_) map.graph().ResetRestShape(newest.ids, map.Positions());
   snapshot.cam_from_world = newest.cam_from_world;
   tracker->SetPose(newest.cam_from_world);
   report->ms_dba = MillisecondsSince(start);

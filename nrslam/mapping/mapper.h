@@ -2,8 +2,8 @@
 //
 // Every frame leaves a snapshot in a temporal buffer (pose, median deformation, each tracked
 // 3D point's pixel and world position, each candidate 2D track's pixel). On a keyframe the
-// keyframe is stored and the DBA runs over the window; its newest shape and pose go back to
-// tracking. On other frames candidates are triangulated, rigidly and deformably, and the
+// keyframe is stored and the DBA runs over the window (rigidly when one shape fits it:
+// MappingOptions::dba_model_selection); its newest shape and pose go back to tracking. On other frames candidates are triangulated, rigidly and deformably, and the
 // paper's model selection keeps one set: the rigid points if there are more than
 // model_selection_factor × as many as deformable ones, the deformable points if there are at
 // least that many times more, else none. New points join the DDG, connected to every point
@@ -73,6 +73,10 @@ class Mapper {
   void Record(const FrameResult& result, const Tracker& tracker);
   Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;
   void RunDba(Tracker* tracker, MappingReport* report);
+  // Of every (keyframe, point) observation, the fraction reprojecting within max_reprojection_px2.
+  double InlierFraction(const std::deque<Keyframe>& keyframes) const;
+  // Camera travel from the oldest to the newest keyframe over the newest one's median depth.
+  double BaselineRatio(const std::deque<Keyframe>& keyframes) const;
   void Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report);
   // The rays of a track's first and last observations met in the middle, if both lie in
   // front and it reprojects within max_reprojection_px2 in both views: the rigid answer, and

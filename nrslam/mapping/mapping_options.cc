@@ -30,6 +30,8 @@ void MappingOptions::Check() const {
                   reprojection_outlier_chi2 > 0 && deformable_min_parallax_px >= 0,
               "mapping", "thresholds must be positive");
   CheckOption(rigid_warmup_keyframes >= 0, "mapping", "rigid_warmup_keyframes must be >= 0");
+  CheckOption(rigid_dba_min_inliers >= 0 && rigid_dba_min_inliers <= 1 && rigid_dba_min_baseline >= 0, "mapping",
+              "need rigid_dba_min_inliers in [0, 1] and rigid_dba_min_baseline >= 0");
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
   CheckOption(model_selection_factor >= 1, "mapping", "model_selection_factor must be >= 1");
 }

@@ -45,6 +45,15 @@ struct MappingOptions {
   // is left alone (warming it up made depth-initialised runs worse). 0 = off (the
   // reference); 4 measured best of 0, 4, 6, 8, 12 on the suite (README, "Mapping").
   int rigid_warmup_keyframes = 4;
+  // Model selection for the DBA (not in the reference; the paper selects models only for new
+  // points): after the warm-up, a window is first adjusted rigidly, and that result is kept
+  // (and becomes the DDG's rest shape) when the camera travelled far enough over the window
+  // and nearly every observation reprojects within max_reprojection_px2. Otherwise the
+  // window gets the deformable DBA. Without it a still scene drifts: the per-keyframe shapes
+  // absorb the noise that a rigid adjustment averages out.
+  bool dba_model_selection = true;
+  double rigid_dba_min_inliers = 0.95;  // fraction of the window's observations
+  double rigid_dba_min_baseline = 0.2;  // camera travel over the window / median depth
   // New points from 2D tracks (corners detected at keyframes) over the last frames.
   int temporal_window = 20;          // frames of track history kept
   double crowding_radius_px = 20;    // no new point this close to a tracked 3D point
@@ -70,7 +79,7 @@ struct MappingOptions {
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
-                                                rigid_warmup_keyframes,
+                                                rigid_warmup_keyframes, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_triangulation, deformable_min_track, deformable_min_parallax_px,

@@ -135,6 +135,11 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
           mapping = mapper.Process(result, bgr, &tracker);
           result.cam_from_world = tracker.pose();  // the DBA may have refined it
           if (mapping.new_points > 0) log << "frame " << frame << ": " << mapping.new_points << " new points\n";
+          if (mapping.dba && mapping.dba_report.baseline_ratio >= 0) {
+            log << "frame " << frame << ": DBA " << (mapping.dba_report.rigid ? "rigid" : "deformable")
+                << std::setprecision(3) << " (baseline ratio " << mapping.dba_report.baseline_ratio << ", rigid inliers "
+                << mapping.dba_report.rigid_inlier_fraction << ")\n";
+          }
         }
       } else if (tracker.state() == TrackingState::kLost && !monocular && !options.run.reinitialise_after_loss) {
         result.state = TrackingState::kLost;
