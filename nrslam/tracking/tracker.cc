@@ -223,13 +223,18 @@ void Tracker::ForgetLostPoints(int frame) {
 void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, FrameResult* result) {
   // Candidates: projecting far enough inside the image for a whole window and onto valid
   // pixels (not under the mask, not in a highlight), grouped by the keyframe of their patch.
+  // Groups keep the order they were first met in: ordered by address, found points would join
+  // the tracks in an order that changes from run to run, and so would the results.
   const double margin = frontend_.klt.window_px / 2 + 1;
-  std::map<const ImagePyramid*, std::vector<std::pair<PointId, Eigen::Vector2d>>> groups;
+  std::vector<std::pair<const ImagePyramid*, std::vector<std::pair<PointId, Eigen::Vector2d>>>> groups;
+  std::unordered_map<const ImagePyramid*, size_t> group_of;
   for (const auto& [id, lost] : lost_) {
     const auto pixel = camera_.Project(cam_from_world_ * map_->point(id).position);
     if (!pixel || !camera_.InImage(*pixel, margin)) continue;
     if (!valid.at<uint8_t>(cvRound(pixel->y()), cvRound(pixel->x()))) continue;
-    groups[lost.patch.keyframe.get()].emplace_back(id, *pixel);
+    const auto [it, added] = group_of.emplace(lost.patch.keyframe.get(), groups.size());
+    if (added) groups.emplace_back(lost.patch.keyframe.get(), std::vector<std::pair<PointId, Eigen::Vector2d>>{});
+    groups[it->second].second.emplace_back(id, *pixel);
   }
   KltOptions search = frontend_.klt;
   search.levels = std::min(search.levels, options_.reassociation_levels);  // the seed is close
