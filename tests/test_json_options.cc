@@ -59,5 +59,11 @@ TEST(JsonOptions, DbaModelSelectionThresholdsAreValidatedAndRoundTrip) {
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"rigid_dba_min_baseline=-0.1"}), Error);
 }
 
+TEST(JsonOptions, DeformableGateSpanIsAChoiceOfTwo) {
+  const MappingOptions shortest = WithAssignments(MappingOptions{}, {"deformable_gate_span=shortest"});
+  EXPECT_EQ(OptionsFromJson<MappingOptions>(Json(shortest), "test").deformable_gate_span, "shortest");
+  EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_gate_span=longest"}), Error);
+}
+
 }  // namespace
 }  // namespace nrslam

@@ -240,6 +240,17 @@ TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
   EXPECT_GT(outcome.deformable_dba, 0);
 }
 
+TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {
+  // Over a track's oldest and newest observations a deforming surface has moved enough for the
+  // rigid rays to miss; the shortest span with enough parallax lets more candidates through.
+  SystemOptions shortest;
+  shortest.mapping.deformable_gate_span = "shortest";
+  const MonocularOutcome reference = RunMonocular("sim-3", SystemOptions{});
+  const MonocularOutcome outcome = RunMonocular("sim-3", shortest);
+  ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
+  EXPECT_GT(outcome.deformable_candidates, reference.deformable_candidates);
+}
+
 // A plain video with a calibration and nothing else (no depth, no poses) runs end to end:
 // initialised from the images, tracked, with nothing to evaluate.
 TEST(MonocularRun, PlainVideoWithoutGroundTruth) {

@@ -149,21 +149,35 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
   report->ms_dba = MillisecondsSince(start);
 }
 
-std::optional<Triangulated> Mapper::TriangulateEnds(const CandidateTrack& track) const {
-  const Snapshot& first = *track.frames.front();
-  const Snapshot& last = *track.frames.back();
-  const Eigen::Vector3d ray0 = first.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.front()).normalized();
-  const Eigen::Vector3d ray1 = last.cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels.back()).normalized();
-  const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, ray0,
-                                         last.cam_from_world.Inverse().translation, ray1);
+Eigen::Vector3d Mapper::WorldRay(const CandidateTrack& track, size_t i) const {
+  return track.frames[i]->cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels[i]).normalized();
+}
+
+std::optional<Triangulated> Mapper::TriangulatePair(const CandidateTrack& track, size_t a, size_t b) const {
+  const Snapshot& first = *track.frames[a];
+  const Snapshot& last = *track.frames[b];
+  const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, WorldRay(track, a),
+                                         last.cam_from_world.Inverse().translation, WorldRay(track, b));
   if (!point || point->depth0 <= 0 || point->depth1 <= 0 ||
-      SquaredReprojectionError(camera_, first.cam_from_world, point->point, track.pixels.front()) >
+      SquaredReprojectionError(camera_, first.cam_from_world, point->point, track.pixels[a]) >
           options_.max_reprojection_px2 ||
-      SquaredReprojectionError(camera_, last.cam_from_world, point->point, track.pixels.back()) >
+      SquaredReprojectionError(camera_, last.cam_from_world, point->point, track.pixels[b]) >
           options_.max_reprojection_px2) {
     return std::nullopt;
   }
   return point;
+}
+
+std::optional<Triangulated> Mapper::TriangulateShortestSpan(const CandidateTrack& track) const {
+  const double min_parallax = options_.deformable_min_parallax_px / camera_.MeanFocal();
+  const size_t newest = track.frames.size() - 1;
+  const Eigen::Vector3d newest_ray = WorldRay(track, newest);
+  for (size_t a = newest; a-- > 0;) {
+    if (std::acos(std::clamp(WorldRay(track, a).dot(newest_ray), -1.0, 1.0)) >= min_parallax) {
+      return TriangulatePair(track, a, newest);
+    }
+  }
+  return std::nullopt;
 }
 
 std::optional<Eigen::Vector3d> Mapper::TriangulateRigid(const CandidateTrack& track,
@@ -185,12 +199,12 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateRigid(const CandidateTrack& tr
 }
 
 std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrack& track,
-                                                             const std::optional<Triangulated>& ends,
+                                                             const std::optional<Triangulated>& gate,
                                                              const std::vector<PointId>& neighbours,
                                                              double map_scale) const {
   const size_t n = track.frames.size();
-  // Gate: the two-view rigid solution must be plausible and have some parallax.
-  if (!ends || ends->parallax_rad < options_.deformable_min_parallax_px / camera_.MeanFocal()) return std::nullopt;
+  // Gate: a two-view rigid solution (mapping.deformable_gate_span) must be plausible, with parallax.
+  if (!gate || gate->parallax_rad < options_.deformable_min_parallax_px / camera_.MeanFocal()) return std::nullopt;
   // Seed: each frame's ray at the mean distance of the neighbours seen in that frame.
   std::vector<Eigen::Vector3d> positions(n);
   std::vector<PoseParams> poses(n);
@@ -318,13 +332,15 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
       const double z = (newest.cam_from_world * point).z();
       return z * options_.max_depth_ratio >= nearest && z <= options_.max_depth_ratio * farthest;
     };
-    const std::optional<Triangulated> ends = TriangulateEnds(track);
+    const std::optional<Triangulated> ends = TriangulatePair(track, 0, track.frames.size() - 1);
     if (const auto point = TriangulateRigid(track, ends, map.scale()); point && plausible(*point)) {
       rigid.emplace_back(candidate.track_id, *point);
     }
     if (!rigid_ && options_.deformable_triangulation &&
         static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-      if (const auto point = TriangulateDeformable(track, ends, neighbours, map.scale()); point && plausible(*point)) {
+      const std::optional<Triangulated> gate =
+          options_.deformable_gate_span == "shortest" ? TriangulateShortestSpan(track) : ends;
+      if (const auto point = TriangulateDeformable(track, gate, neighbours, map.scale()); point && plausible(*point)) {
         deformable.emplace_back(candidate.track_id, *point);
       }
     }

@@ -78,14 +78,19 @@ class Mapper {
   // Camera travel from the oldest to the newest keyframe over the newest one's median depth.
   double BaselineRatio(const std::deque<Keyframe>& keyframes) const;
   void Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report);
-  // The rays of a track's first and last observations met in the middle, if both lie in
-  // front and it reprojects within max_reprojection_px2 in both views: the rigid answer, and
-  // the deformable triangulation's plausibility gate.
-  std::optional<Triangulated> TriangulateEnds(const CandidateTrack& track) const;
+  // Observation i's viewing ray, in the world frame.
+  Eigen::Vector3d WorldRay(const CandidateTrack& track, size_t i) const;
+  // The rays of observations a and b met in the middle, if both lie in front and it
+  // reprojects within max_reprojection_px2 in both views. Over the first and last
+  // observations: the rigid answer, and the deformable triangulation's reference gate.
+  std::optional<Triangulated> TriangulatePair(const CandidateTrack& track, size_t a, size_t b) const;
+  // The same over the newest observation and the latest earlier one with
+  // deformable_min_parallax_px of parallax (mapping.deformable_gate_span=shortest).
+  std::optional<Triangulated> TriangulateShortestSpan(const CandidateTrack& track) const;
   std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, const std::optional<Triangulated>& ends,
                                                   double map_scale) const;
   std::optional<Eigen::Vector3d> TriangulateDeformable(const CandidateTrack& track,
-                                                       const std::optional<Triangulated>& ends,
+                                                       const std::optional<Triangulated>& gate,
                                                        const std::vector<PointId>& neighbours, double map_scale) const;
 };
 
