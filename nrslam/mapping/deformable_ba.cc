@@ -42,6 +42,10 @@ DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationMode
     Keyframe& keyframe = *window[k];
     for (size_t i = 0; i < keyframe.ids.size(); ++i) {
       double* block = rigid ? shared.at(keyframe.ids[i]).data() : keyframe.positions[i].data();
+      // A shared position seeded from another keyframe can lie behind this one's camera when
+      // the tissue moved in between; its residual would fail Ceres's first evaluation and
+      // with it the whole solve, so that observation sits the adjustment out.
+      if (rigid && !camera.Project(keyframe.cam_from_world * Eigen::Map<const Eigen::Vector3d>(block))) continue;
       blocks[k][keyframe.ids[i]] = block;
       points.insert(keyframe.ids[i]);
       problem.AddResidualBlock(CreateReprojectionCost(camera, keyframe.pixels[i], options.reprojection_sigma_px),
