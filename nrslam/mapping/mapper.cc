@@ -9,6 +9,7 @@
 
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
+#include "nrslam/util/median.h"
 #include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
@@ -99,10 +100,9 @@ double Mapper::BaselineRatio(const std::deque<Keyframe>& keyframes) const {
   std::vector<double> depths;
   for (const Eigen::Vector3d& x : newest.positions) depths.push_back((newest.cam_from_world * x).z());
   if (depths.empty()) return 0;
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
   const double travel = (newest.cam_from_world.Inverse().translation -
                          keyframes.front().cam_from_world.Inverse().translation).norm();
-  return travel / depths[depths.size() / 2];
+  return travel / Median(depths);
 }
 
 void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
@@ -111,17 +111,17 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
   const bool warmup = two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
   bool rigid_shape = rigid_ || warmup;
   bool adjusted = false;
-  DbaReport selection;
+  double baseline_ratio = -1, rigid_inlier_fraction = -1;  // not measured
   if (!rigid_shape && options_.dba_model_selection) {
     // The tracked camera travel, before any adjustment: a short baseline leaves a rigid fit
     // free to turn deformation into depth error, however well it reprojects.
-    selection.baseline_ratio = BaselineRatio(keyframes_);
-    if (selection.baseline_ratio >= options_.rigid_dba_min_baseline) {
+    baseline_ratio = BaselineRatio(keyframes_);
+    if (baseline_ratio >= options_.rigid_dba_min_baseline) {
       std::deque<Keyframe> trial = keyframes_;
       const DbaReport rigid_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
                                                                 options_.dba_iterations, true, Pointers(&trial));
-      selection.rigid_inlier_fraction = InlierFraction(trial);
-      if (selection.rigid_inlier_fraction >= options_.rigid_dba_min_inliers) {
+      rigid_inlier_fraction = InlierFraction(trial);
+      if (rigid_inlier_fraction >= options_.rigid_dba_min_inliers) {
         keyframes_ = std::move(trial);
         report->dba_report = rigid_report;
         rigid_shape = adjusted = true;
@@ -133,8 +133,8 @@ void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
                                                     options_.dba_iterations, rigid_shape, Pointers(&keyframes_));
   }
   report->dba_report.rigid = rigid_shape;
-  report->dba_report.baseline_ratio = selection.baseline_ratio;
-  report->dba_report.rigid_inlier_fraction = selection.rigid_inlier_fraction;
+  report->dba_report.baseline_ratio = baseline_ratio;
+  report->dba_report.rigid_inlier_fraction = rigid_inlier_fraction;
   report->dba = true;
   // The newest keyframe is this frame: its shape and pose are what tracking goes on from.
   const Keyframe& newest = keyframes_.back();
@@ -169,11 +169,12 @@ std::optional<Triangulated> Mapper::TriangulatePair(const CandidateTrack& track,
 }
 
 std::optional<Triangulated> Mapper::TriangulateShortestSpan(const CandidateTrack& track) const {
-  const double min_parallax = options_.deformable_min_parallax_px / camera_.MeanFocal();
+  // Enough parallax: an angle ≥ the minimum, i.e. a cosine ≤ its cosine (unit rays).
+  const double max_cosine = std::cos(options_.deformable_min_parallax_px / camera_.MeanFocal());
   const size_t newest = track.frames.size() - 1;
   const Eigen::Vector3d newest_ray = WorldRay(track, newest);
   for (size_t a = newest; a-- > 0;) {
-    if (std::acos(std::clamp(WorldRay(track, a).dot(newest_ray), -1.0, 1.0)) >= min_parallax) {
+    if (WorldRay(track, a).dot(newest_ray) <= max_cosine) {
       return TriangulatePair(track, a, newest);
     }
   }
@@ -292,6 +293,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   const double crowding2 = options_.crowding_radius_px * options_.crowding_radius_px;
   const double radius2 = options_.neighbour_radius_px * options_.neighbour_radius_px;
   std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
+  const bool shortest_gate = options_.deformable_gate_span == "shortest";
   for (const CandidateObservation& candidate : result.candidates) {
     // Crowding gate and neighbours: the nearest tracked 3D points in the image.
     std::vector<std::pair<double, PointId>> near;
@@ -338,8 +340,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
     }
     if (!rigid_ && options_.deformable_triangulation &&
         static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-      const std::optional<Triangulated> gate =
-          options_.deformable_gate_span == "shortest" ? TriangulateShortestSpan(track) : ends;
+      const std::optional<Triangulated> gate = shortest_gate ? TriangulateShortestSpan(track) : ends;
       if (const auto point = TriangulateDeformable(track, gate, neighbours, map.scale()); point && plausible(*point)) {
         deformable.emplace_back(candidate.track_id, *point);
       }

@@ -10,6 +10,7 @@
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
 #include "nrslam/geometry/two_view.h"
+#include "nrslam/util/median.h"
 
 namespace nrslam {
 
@@ -177,8 +178,7 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
   // Scale: median reference-camera depth → options_.median_depth.
   std::vector<double> depths;
   for (const auto& p : points) depths.push_back(p.z());
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  const double factor = options_.median_depth / depths[depths.size() / 2];
+  const double factor = options_.median_depth / Median(depths);
   double mean = 0, squares = 0;
   for (auto& p : points) {
     p *= factor;

@@ -136,9 +136,11 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
           result.cam_from_world = tracker.pose();  // the DBA may have refined it
           if (mapping.new_points > 0) log << "frame " << frame << ": " << mapping.new_points << " new points\n";
           if (mapping.dba && mapping.dba_report.baseline_ratio >= 0) {
-            log << "frame " << frame << ": DBA " << (mapping.dba_report.rigid ? "rigid" : "deformable")
-                << std::setprecision(3) << " (baseline ratio " << mapping.dba_report.baseline_ratio << ", rigid inliers "
-                << mapping.dba_report.rigid_inlier_fraction << ")\n";
+            std::ostringstream line;  // its precision stays with this line, not the whole log
+            line << "frame " << frame << ": DBA " << (mapping.dba_report.rigid ? "rigid" : "deformable")
+                 << std::setprecision(3) << " (baseline ratio " << mapping.dba_report.baseline_ratio
+                 << ", rigid inliers " << mapping.dba_report.rigid_inlier_fraction << ")\n";
+            log << line.str();
           }
         }
       } else if (tracker.state() == TrackingState::kLost && !monocular && !options.run.reinitialise_after_loss) {

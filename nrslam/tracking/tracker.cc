@@ -16,6 +16,7 @@
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
 #include "nrslam/geometry/se3_manifold.h"
+#include "nrslam/util/median.h"
 #include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
@@ -99,8 +100,7 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
   }
   mean /= depths.size();
   seed.depth_deviation = std::sqrt(std::max(1e-12, squares / depths.size() - mean * mean));
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  seed.scale = depths[depths.size() / 2] / 3.0;
+  seed.scale = Median(depths) / 3.0;
   return InitialiseFromSeed(frame, bgr, mask, seed);
 }
 
@@ -226,14 +226,15 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
   // Groups keep the order they were first met in: ordered by address, found points would join
   // the tracks in an order that changes from run to run, and so would the results.
   const double margin = frontend_.klt.window_px / 2 + 1;
-  std::vector<std::pair<const ImagePyramid*, std::vector<std::pair<PointId, Eigen::Vector2d>>>> groups;
+  using Candidates = std::vector<std::pair<PointId, Eigen::Vector2d>>;  // id, projection
+  std::vector<std::pair<const ImagePyramid*, Candidates>> groups;
   std::unordered_map<const ImagePyramid*, size_t> group_of;
   for (const auto& [id, lost] : lost_) {
     const auto pixel = camera_.Project(cam_from_world_ * map_->point(id).position);
     if (!pixel || !camera_.InImage(*pixel, margin)) continue;
     if (!valid.at<uint8_t>(cvRound(pixel->y()), cvRound(pixel->x()))) continue;
     const auto [it, added] = group_of.emplace(lost.patch.keyframe.get(), groups.size());
-    if (added) groups.emplace_back(lost.patch.keyframe.get(), std::vector<std::pair<PointId, Eigen::Vector2d>>{});
+    if (added) groups.emplace_back(lost.patch.keyframe.get(), Candidates{});
     groups[it->second].second.emplace_back(id, *pixel);
   }
   KltOptions search = frontend_.klt;
@@ -468,10 +469,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     for (size_t i = 0; i < observations.size(); ++i) {
       if (inliers[i]) inlier_norms.push_back(norms[i]);
     }
-    if (!inlier_norms.empty()) {
-      std::nth_element(inlier_norms.begin(), inlier_norms.begin() + inlier_norms.size() / 2, inlier_norms.end());
-      result.median_displacement = inlier_norms[inlier_norms.size() / 2];
-    }
+    if (!inlier_norms.empty()) result.median_displacement = Median(inlier_norms);
     for (size_t i = 0; i < observations.size(); ++i) {
       demoted[i] = norms[i] >= fence && norms[i] > 0;
       if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
