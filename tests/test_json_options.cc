@@ -59,10 +59,12 @@ TEST(JsonOptions, DbaModelSelectionThresholdsAreValidatedAndRoundTrip) {
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"rigid_dba_min_baseline=-0.1"}), Error);
 }
 
-TEST(JsonOptions, DeformableGateSpanIsAChoiceOfTwo) {
+TEST(JsonOptions, DeformableGateSpanOptionsAreValidated) {
   const MappingOptions shortest = WithAssignments(MappingOptions{}, {"deformable_gate_span=shortest"});
   EXPECT_EQ(OptionsFromJson<MappingOptions>(Json(shortest), "test").deformable_gate_span, "shortest");
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_gate_span=longest"}), Error);
+  EXPECT_THROW(WithAssignments(MappingOptions{}, {"shortest_gate_below_fraction=1.5"}), Error);
+  EXPECT_EQ(WithAssignments(MappingOptions{}, {"shortest_gate_below_fraction=0"}).shortest_gate_below_fraction, 0.0);
 }
 
 }  // namespace

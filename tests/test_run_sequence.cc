@@ -242,13 +242,20 @@ TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
 
 TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {
   // Over a track's oldest and newest observations a deforming surface has moved enough for the
-  // rigid rays to miss; the shortest span with enough parallax lets more candidates through.
-  SystemOptions shortest;
+  // rigid rays to miss; the shortest span with enough parallax lets more candidates through,
+  // on every frame ("shortest") or only on frames where the map has thinned (the default).
+  SystemOptions oldest, shortest;
+  oldest.mapping.shortest_gate_below_fraction = 0;
   shortest.mapping.deformable_gate_span = "shortest";
-  const MonocularOutcome reference = RunMonocular("sim-3", SystemOptions{});
+  const MonocularOutcome reference = RunMonocular("sim-3", oldest);
+  const MonocularOutcome adaptive = RunMonocular("sim-3", SystemOptions{});
   const MonocularOutcome outcome = RunMonocular("sim-3", shortest);
   ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
+  std::cout << "deformable candidates oldest / adaptive / shortest: " << reference.deformable_candidates << " / "
+            << adaptive.deformable_candidates << " / " << outcome.deformable_candidates << "\n";
   EXPECT_GT(outcome.deformable_candidates, reference.deformable_candidates);
+  EXPECT_GT(adaptive.deformable_candidates, reference.deformable_candidates);
+  EXPECT_GT(adaptive.new_points, reference.new_points);
 }
 
 // A plain video with a calibration and nothing else (no depth, no poses) runs end to end:

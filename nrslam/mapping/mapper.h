@@ -69,6 +69,7 @@ class Mapper {
   std::deque<Keyframe> keyframes_;
   int map_keyframes_ = 0;  // keyframes made since the map started
   bool two_view_map_ = false;  // the map came from monocular initialisation (not from depth)
+  int start_points_ = 0;       // 3D points the map started with
 
   void Record(const FrameResult& result, const Tracker& tracker);
   Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;
@@ -85,7 +86,8 @@ class Mapper {
   // observations: the rigid answer, and the deformable triangulation's reference gate.
   std::optional<Triangulated> TriangulatePair(const CandidateTrack& track, size_t a, size_t b) const;
   // The same over the newest observation and the latest earlier one with
-  // deformable_min_parallax_px of parallax (mapping.deformable_gate_span=shortest).
+  // deformable_min_parallax_px of parallax (mapping.deformable_gate_span=shortest, and on
+  // frames below mapping.shortest_gate_below_fraction of the map's first points).
   std::optional<Triangulated> TriangulateShortestSpan(const CandidateTrack& track) const;
   std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, const std::optional<Triangulated>& ends,
                                                   double map_scale) const;

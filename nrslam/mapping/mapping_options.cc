@@ -35,6 +35,8 @@ void MappingOptions::Check() const {
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
   CheckOption(deformable_gate_span == "oldest" || deformable_gate_span == "shortest", "mapping",
               "deformable_gate_span must be oldest or shortest, got '" + deformable_gate_span + "'");
+  CheckOption(shortest_gate_below_fraction >= 0 && shortest_gate_below_fraction <= 1, "mapping",
+              "shortest_gate_below_fraction must be in [0, 1]");
   CheckOption(model_selection_factor >= 1, "mapping", "model_selection_factor must be >= 1");
 }
 

@@ -76,6 +76,12 @@ struct MappingOptions {
   // temporal_window frames) a deforming surface moves enough for the rays to miss: in the
   // 300-frame sim-3 run's point dip, 330 of ~400 candidates per frame failed the gate there.
   std::string deformable_gate_span = "oldest";
+  // ... except on frames that track fewer than this fraction of the points the map started
+  // with, where the shortest span is used whatever deformable_gate_span says (0: never). A
+  // starving map needs new points more than it needs the stricter gate. A fraction rather
+  // than a count, so that it holds at any image size; measured in the top-level README,
+  // "Mapping".
+  double shortest_gate_below_fraction = 0.35;
   int deformable_min_track = 5;      // deformable triangulation needs this many observations
   double deformable_min_parallax_px = 5;
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
@@ -89,7 +95,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window,
                                                 rigid_warmup_keyframes, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
-                                                max_reprojection_px2, deformable_triangulation, deformable_gate_span, deformable_min_track, deformable_min_parallax_px,
+                                                max_reprojection_px2, deformable_triangulation, deformable_gate_span,
+                                                shortest_gate_below_fraction, deformable_min_track, deformable_min_parallax_px,
                                                 flow_sigma, deformable_iterations, flow_outlier_chi2,
                                                 reprojection_outlier_chi2, model_selection_factor)
 
