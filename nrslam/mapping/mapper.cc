@@ -294,9 +294,9 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   const double crowding2 = options_.crowding_radius_px * options_.crowding_radius_px;
   const double radius2 = options_.neighbour_radius_px * options_.neighbour_radius_px;
   std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
-  const bool shortest_gate = options_.deformable_gate_span == "shortest" ||
-                             static_cast<double>(result.points.size()) <
-                                 options_.shortest_gate_below_fraction * static_cast<double>(start_points_);
+  const bool starving = two_view_map_ && static_cast<double>(result.points.size()) <
+                                            options_.shortest_gate_below_fraction * static_cast<double>(start_points_);
+  const bool shortest_gate = options_.deformable_gate_span == "shortest" || starving;
   for (const CandidateObservation& candidate : result.candidates) {
     // Crowding gate and neighbours: the nearest tracked 3D points in the image.
     std::vector<std::pair<double, PointId>> near;

@@ -87,7 +87,7 @@ class Mapper {
   std::optional<Triangulated> TriangulatePair(const CandidateTrack& track, size_t a, size_t b) const;
   // The same over the newest observation and the latest earlier one with
   // deformable_min_parallax_px of parallax (mapping.deformable_gate_span=shortest, and on
-  // frames below mapping.shortest_gate_below_fraction of the map's first points).
+  // frames below mapping.shortest_gate_below_fraction of a monocular map's first points).
   std::optional<Triangulated> TriangulateShortestSpan(const CandidateTrack& track) const;
   std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, const std::optional<Triangulated>& ends,
                                                   double map_scale) const;

@@ -76,11 +76,12 @@ struct MappingOptions {
   // temporal_window frames) a deforming surface moves enough for the rays to miss: in the
   // 300-frame sim-3 run's point dip, 330 of ~400 candidates per frame failed the gate there.
   std::string deformable_gate_span = "oldest";
-  // ... except on frames that track fewer than this fraction of the points the map started
-  // with, where the shortest span is used whatever deformable_gate_span says (0: never). A
-  // starving map needs new points more than it needs the stricter gate. A fraction rather
-  // than a count, so that it holds at any image size; measured in the top-level README,
-  // "Mapping".
+  // ... except on frames that track fewer than this fraction of the points a monocular map
+  // started with, where the shortest span is used whatever deformable_gate_span says (0:
+  // never). A starving map needs new points more than it needs the stricter gate. A fraction
+  // rather than a count, so that it holds at any image size. Not for maps from depth: they
+  // start accurate, and the looser gate's points cost them more than they add (measured in
+  // the top-level README, "Mapping").
   double shortest_gate_below_fraction = 0.35;
   int deformable_min_track = 5;      // deformable triangulation needs this many observations
   double deformable_min_parallax_px = 5;
