@@ -258,6 +258,21 @@ TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {
   EXPECT_GT(adaptive.new_points, reference.new_points);
 }
 
+TEST(DepthMappingRun, StarvingMapRuleLeavesItAlone) {
+  // A map from depth starts accurate: the looser gate is for monocular maps only, so even a
+  // rule that holds on every frame (fraction 1) must leave a depth-initialised run unchanged.
+  SystemOptions never, always;
+  never.run.init = always.run.init = "depth";
+  never.mapping.shortest_gate_below_fraction = 0;
+  always.mapping.shortest_gate_below_fraction = 1;
+  const MonocularOutcome reference = RunMonocular("sim-3", never);
+  const MonocularOutcome outcome = RunMonocular("sim-3", always);
+  EXPECT_EQ(outcome.summary.frames_tracked, reference.summary.frames_tracked);
+  EXPECT_EQ(outcome.deformable_candidates, reference.deformable_candidates);
+  EXPECT_EQ(outcome.new_points, reference.new_points);
+  EXPECT_DOUBLE_EQ(outcome.summary.rmse_mm, reference.summary.rmse_mm);
+}
+
 // A plain video with a calibration and nothing else (no depth, no poses) runs end to end:
 // initialised from the images, tracked, with nothing to evaluate.
 TEST(MonocularRun, PlainVideoWithoutGroundTruth) {
