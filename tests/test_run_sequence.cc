@@ -19,6 +19,7 @@
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace nrslam {
 namespace {
@@ -121,6 +122,55 @@ TEST_F(RunSequenceTest, SummaryRmseIsRecomputableFromPointsCsvAndGroundTruth) {
   EXPECT_NEAR(recomputed.rmse_median_mm, summary.at("rmse_median_mm").get<double>(), 1e-5);
   EXPECT_NEAR(recomputed.rmse_pooled_mm, summary.at("rmse_pooled_mm").get<double>(), 1e-5);
   EXPECT_EQ(summary.at("frames_tracked").get<int>(), 40);
+}
+
+// A run folder's config.json repeats the run: the same options, and the same trajectory.
+TEST_F(RunSequenceTest, SavedConfigRepeatsTheRun) {
+  const SystemOptions loaded = SystemOptionsFromFile(*base_ / "run" / "config.json");
+  EXPECT_EQ(Json(loaded), Json(TrackingExperiment()));
+  const RunSummary repeated = RunSequence(*base_ / "sequence", loaded, *base_ / "repeated");
+  EXPECT_EQ(repeated.frames_tracked, summary_->frames_tracked);
+  EXPECT_EQ(repeated.rmse_mm, summary_->rmse_mm);
+  const auto text = [](const fs::path& file) {
+    std::ostringstream content;
+    content << std::ifstream(file).rdbuf();
+    return content.str();
+  };
+  EXPECT_EQ(text(*base_ / "repeated" / "trajectory.tum"), text(*base_ / "run" / "trajectory.tum"));
+}
+
+TEST(SystemOptionsNames, UniqueLastNamesResolveToFullPaths) {
+  EXPECT_EQ(ResolveRunAssignment("k=2"), "deformation.k=2");
+  EXPECT_EQ(ResolveRunAssignment("max_degree_D=5"), "deformation.max_degree_D=5");
+  EXPECT_EQ(ResolveRunAssignment("mapping.dba_window=7"), "mapping.dba_window=7");
+  EXPECT_EQ(ResolveRunAssignment("camera={\"a\": 1}"), "run.camera={\"a\": 1}");  // only the name resolved
+  EXPECT_THROW(ResolveRunAssignment("min_points=5"), Error);  // evaluation, initialisation and tracking
+  EXPECT_THROW(ResolveRunAssignment("kk=2"), Error);
+  EXPECT_THROW(ResolveRunAssignment("k"), Error);
+}
+
+TEST(SystemOptionsFile, PartialOptionsOverTheDefaultsAndUnknownKeysRejected) {
+  const fs::path folder = UniqueTempFolder("nrslam_options_file");
+  fs::create_directories(folder);
+  std::ofstream(folder / "partial.json") << R"({"mapping": {"dba_window": 7}, "run": {"init": "depth"}})";
+  const SystemOptions partial = SystemOptionsFromFile(folder / "partial.json");
+  SystemOptions expected;
+  expected.mapping.dba_window = 7;
+  expected.run.init = "depth";
+  EXPECT_EQ(Json(partial), Json(expected));
+  std::ofstream(folder / "typo.json") << R"({"mapping": {"dba_widnow": 7}})";
+  try {
+    SystemOptionsFromFile(folder / "typo.json");
+    ADD_FAILURE() << "an unknown key must be an error";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("dba_widnow"), std::string::npos) << error.what();
+  }
+  std::ofstream(folder / "invalid.json") << R"({"mapping": {"dba_window": -1}})";
+  EXPECT_THROW(SystemOptionsFromFile(folder / "invalid.json"), Error);
+  std::ofstream(folder / "list.json") << "[1, 2]";
+  EXPECT_THROW(SystemOptionsFromFile(folder / "list.json"), Error);
+  EXPECT_THROW(SystemOptionsFromFile(folder / "missing.json"), Error);
+  fs::remove_all(folder);
 }
 
 TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {

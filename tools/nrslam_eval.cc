@@ -12,6 +12,7 @@
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
+#include "nrslam/system/system_options.h"
 
 namespace {
 
@@ -83,11 +84,7 @@ int main(int argc, char** argv) {
     std::vector<nrslam::Sweep> grid;
     for (const std::string& sweep : sweeps) grid.push_back(nrslam::ParseSweep(sweep));
     std::vector<std::string> resolved;
-    for (const std::string& assignment : assignments) {
-      const size_t equals = assignment.find('=');
-      if (equals == std::string::npos) throw nrslam::Error("--set '" + assignment + "': expected name=value");
-      resolved.push_back(nrslam::ResolveRunOption(assignment.substr(0, equals)) + assignment.substr(equals));
-    }
+    for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
     if (merge->parsed()) {
       // Runs of the same plan executed elsewhere: gather their run folders under --out.
       const nrslam::Manifest manifest = nrslam::LoadManifest(merge_manifest);

@@ -9,23 +9,26 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"Run NR-SLAM over a sequence and write its run folder."};
-  std::string sequence, out, init = nrslam::RunOptions{}.init;
+  std::string sequence, out, config_path, init;
   bool rigid = false, no_mapping = false, quiet = false, print_options = false;
   std::vector<std::string> assignments;
   app.add_option("sequence", sequence, "sequence folder")->required();
   app.add_option("--out", out, "run folder to write")->required();
-  app.add_option("--init", init, "monocular (the map from the images: full NR-SLAM) or depth (from the sequence's depth)")->capture_default_str();
+  app.add_option("--config", config_path, "JSON options applied over the defaults: a run folder's config.json (to repeat that run) or an options object");
+  app.add_option("--init", init, "monocular (the map from the images: full NR-SLAM, the default) or depth (from the sequence's depth)");
   app.add_flag("--rigid", rigid, "rigid baseline: no deformation");
   app.add_flag("--no-mapping", no_mapping, "tracking only, no keyframe DBA or new points (the paper's Table II experiment)");
-  app.add_option("--set", assignments, "set any option, e.g. --set deformation.k=2 (see --print-options)");
+  app.add_option("--set", assignments, "set any option by its path or a unique last name, e.g. --set deformation.k=2 or --set k=2 (see --print-options)");
   app.add_flag("--print-options", print_options, "print every option as JSON and exit");
   app.add_flag("--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
   try {
-    nrslam::SystemOptions options;
-    options.run.init = init;
-    options.tracking.rigid = rigid;
+    // Defaults, then the file, then the flags given, then --set: each overrides the one before.
+    nrslam::SystemOptions options = config_path.empty() ? nrslam::SystemOptions{} : nrslam::SystemOptionsFromFile(config_path);
+    if (!init.empty()) options.run.init = init;
+    if (rigid) options.tracking.rigid = true;
     if (no_mapping) options.run.mapping = false;
+    for (std::string& assignment : assignments) assignment = nrslam::ResolveRunAssignment(assignment);
     options = nrslam::WithAssignments(options, assignments);
     if (print_options) {
       std::cout << nrslam::Json(options).dump(2) << '\n';

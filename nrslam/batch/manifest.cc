@@ -9,20 +9,6 @@
 
 namespace nrslam {
 
-std::string ResolveRunOption(const std::string& name) {
-  static const std::vector<std::string> paths = LeafPaths(Json(SystemOptions{}));
-  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
-  std::vector<std::string> matches;
-  for (const std::string& path : paths) {
-    const size_t dot = path.rfind('.');
-    if (path.substr(dot == std::string::npos ? 0 : dot + 1) == name) matches.push_back(path);
-  }
-  if (matches.size() == 1) return matches.front();
-  std::string known;
-  for (const std::string& path : matches.empty() ? paths : matches) known += (known.empty() ? "" : ", ") + path;
-  throw Error("option '" + name + "' is " + (matches.empty() ? "unknown; options are: " : "ambiguous: ") + known);
-}
-
 std::string Assignment(const std::string& path, const Json& value) {
   return path + "=" + (value.is_string() ? value.get<std::string>() : value.dump());
 }

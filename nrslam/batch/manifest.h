@@ -46,10 +46,6 @@ struct Manifest {
 // Throws Error naming the manifest, the sequence and what is wrong.
 Manifest LoadManifest(const std::filesystem::path& file);
 
-// A run option's full path from a full path or a unique last name ("k" → "deformation.k");
-// throws Error listing the candidates when unknown or ambiguous.
-std::string ResolveRunOption(const std::string& name);
-
 // "path=value" for a JSON value (strings unquoted).
 std::string Assignment(const std::string& path, const Json& value);
 

@@ -1,5 +1,8 @@
 #include "nrslam/system/system_options.h"
 
+#include <algorithm>
+#include <vector>
+
 #include "nrslam/util/json_options.h"
 
 namespace nrslam {
@@ -7,6 +10,34 @@ namespace nrslam {
 void RunOptions::Check() const {
   CheckOption(init == "depth" || init == "monocular", "run", "init must be depth or monocular, got '" + init + "'");
   CheckOption(first_frame >= 0 && (last_frame < 0 || last_frame > first_frame), "run", "bad frame range");
+}
+
+SystemOptions SystemOptionsFromFile(const std::filesystem::path& file) {
+  const Json given = ReadJsonFile(file);
+  if (!given.is_object()) throw Error(file.string() + ": options must be a JSON object");
+  // A run folder's config.json also records the sequence, camera and version it ran with.
+  const bool run_config = given.contains("options") && given.contains("nrslam_version");
+  return OptionsFromJson<SystemOptions>(run_config ? given.at("options") : given, file.string());
+}
+
+std::string ResolveRunOption(const std::string& name) {
+  static const std::vector<std::string> paths = LeafPaths(Json(SystemOptions{}));
+  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
+  std::vector<std::string> matches;
+  for (const std::string& path : paths) {
+    const size_t dot = path.rfind('.');
+    if (path.substr(dot == std::string::npos ? 0 : dot + 1) == name) matches.push_back(path);
+  }
+  if (matches.size() == 1) return matches.front();
+  std::string known;
+  for (const std::string& path : matches.empty() ? paths : matches) known += (known.empty() ? "" : ", ") + path;
+  throw Error("option '" + name + "' is " + (matches.empty() ? "unknown; options are: " : "ambiguous: ") + known);
+}
+
+std::string ResolveRunAssignment(const std::string& assignment) {
+  const size_t equals = assignment.find('=');
+  if (equals == std::string::npos) throw Error("--set '" + assignment + "': expected name=value");
+  return ResolveRunOption(assignment.substr(0, equals)) + assignment.substr(equals);
 }
 
 }  // namespace nrslam

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <string>
 
 #include "nrslam/deformation/deformation_options.h"
@@ -50,5 +51,16 @@ struct SystemOptions {
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SystemOptions, run, frontend, deformation, tracking, initialisation,
                                                 mapping, evaluation)
+
+// Options from a JSON file over the defaults: a run folder's config.json (its "options") or a
+// bare options object, whole or partial. Unknown keys are errors, so a saved run is repeated
+// exactly or not at all.
+SystemOptions SystemOptionsFromFile(const std::filesystem::path& file);
+
+// A run option's full path from a full path or a unique last name ("k" → "deformation.k");
+// throws Error listing the candidates when unknown or ambiguous.
+std::string ResolveRunOption(const std::string& name);
+// "name=value" with the name resolved as above; throws Error without an "=".
+std::string ResolveRunAssignment(const std::string& assignment);
 
 }  // namespace nrslam
