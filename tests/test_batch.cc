@@ -12,6 +12,7 @@
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 #include "nrslam/sim/renderer.h"
+#include "nrslam/system/system_options.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -327,6 +328,32 @@ TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
   EXPECT_EQ(std::filesystem::last_write_time(plan.runs[0].run_folder / "summary.json"), untouched);
   const std::vector<RunResult> second = CollectResults(plan);
   EXPECT_DOUBLE_EQ(second[1].rmse_mm, first[1].rmse_mm);  // the same run, the same answer
+  std::filesystem::remove_all(folder);
+}
+
+// The same --out reused with other options must not report the old runs as the new ones.
+TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
+  const auto folder = UniqueTempFolder("batch_superseded");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({
+    "defaults": {"init": "depth"},
+    "sequences": [{"name": "s", "preset": "sim-1", "simulate": )") + kTinySimulate + "}]}"));
+  const EvaluationPlan stiff = PlanEvaluation(manifest, {"deformation.k=3"}, {}, folder / "out", folder / "cache");
+  const EvaluationPlan plain = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  ExecutePlan(stiff, kPrograms, 2, [](const std::string&) {});
+  ASSERT_EQ(CollectResults(stiff)[0].status, "ok") << CollectResults(stiff)[0].error;
+  EXPECT_TRUE(RunIsFinished(stiff.runs[0]));
+  EXPECT_FALSE(RunIsFinished(plain.runs[0]));
+  std::vector<std::string> lines;
+  ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options or another sequence: run again");
+  EXPECT_NE(lines[1].find("[1/1] s done"), std::string::npos) << lines[1];
+  const Json config = ReadJsonFile(plain.runs[0].run_folder / "config.json");
+  EXPECT_EQ(config.at("options").at("deformation").at("k"), Json(DeformationModelOptions{}.k));
+  EXPECT_TRUE(RunIsFinished(plain.runs[0]));
+  lines.clear();
+  ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
+  EXPECT_EQ(lines, std::vector<std::string>{"1 run(s) already finished, not run again"});
   std::filesystem::remove_all(folder);
 }
 

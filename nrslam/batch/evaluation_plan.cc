@@ -133,7 +133,7 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
       SystemOptions options;
       options.tracking.rigid = sequence.rigid;
       try {
-        WithAssignments(options, assignments);
+        run.options = WithAssignments(options, assignments);
       } catch (const Error& e) {
         throw Error("sequence '" + sequence.name + "'" + (run.label.empty() ? "" : " at " + run.label) + ": " +
                     e.what());
@@ -179,7 +179,19 @@ std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Pr
   return PrepareShellLine(plan.prepares[run.prepare], programs) + " && " + command;
 }
 
-bool RunIsFinished(const RunJob& run) { return std::filesystem::exists(run.run_folder / "summary.json"); }
+bool RunIsFinished(const RunJob& run) {
+  if (!std::filesystem::exists(run.run_folder / "summary.json")) return false;
+  try {
+    const Json config = ReadJsonFile(run.run_folder / "config.json");
+    // Parsed back through the options struct, so that a config written before an option
+    // existed compares as that option's default.
+    const Json options = OptionsFromJson<SystemOptions>(config.at("options"), "config.json");
+    return options == run.options &&
+           config.at("sequence").get<std::string>() == std::filesystem::absolute(run.sequence_folder).string();
+  } catch (const std::exception&) {
+    return false;  // unreadable, or from a version with options this one lacks: run it again
+  }
+}
 
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
                  const std::function<void(const std::string&)>& progress) {
@@ -214,12 +226,16 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
 
   std::vector<Command> runs;
   std::vector<size_t> run_index;
-  size_t skipped = 0;
+  size_t skipped = 0, superseded = 0;
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     const RunJob& run = plan.runs[i];
     if (RunIsFinished(run)) {
       ++skipped;
       continue;
+    }
+    if (std::filesystem::exists(run.run_folder / "summary.json")) {
+      ++superseded;  // a finished run of other options: none of its files may outlive it
+      std::filesystem::remove_all(run.run_folder);
     }
     std::filesystem::remove(run.run_folder / "failure.json");
     if (run.prepare >= 0 && !prepare_errors[run.prepare].empty()) {
@@ -233,6 +249,9 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
     run_index.push_back(i);
   }
   if (skipped > 0) progress(std::to_string(skipped) + " run(s) already finished, not run again");
+  if (superseded > 0) {
+    progress(std::to_string(superseded) + " run(s) in the output folder had other options or another sequence: run again");
+  }
   size_t finished = 0;
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const RunJob& run = plan.runs[run_index[k]];

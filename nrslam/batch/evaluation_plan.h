@@ -35,6 +35,7 @@ struct RunJob {
   std::filesystem::path sequence_folder;
   std::filesystem::path run_folder;          // out/runs/<sequence>[/<label>]
   std::vector<std::string> arguments;        // nrslam_run's arguments (no program name)
+  Json options;                              // the options those arguments resolve to
   int prepare = -1;                          // index into EvaluationPlan::prepares, or -1
 };
 
@@ -61,7 +62,9 @@ std::string PrepareShellLine(const PrepareJob& prepare, const Programs& programs
 // The shell command of one run, self-contained: prepares its sequence first if needed.
 std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Programs& programs);
 
-// A run whose folder already holds a summary.json finished before: it is not run again.
+// A run whose folder already holds a summary.json, and a config.json with this run's options
+// and sequence, finished before: it is not run again. A folder from other options (an --out
+// reused after changing --set or the manifest) is run again rather than reported stale.
 bool RunIsFinished(const RunJob& run);
 
 // Prepares what is missing, then runs what is not finished, `jobs` processes at a time.
