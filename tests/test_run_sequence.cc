@@ -149,6 +149,17 @@ TEST(SystemOptionsNames, UniqueLastNamesResolveToFullPaths) {
   EXPECT_THROW(ResolveRunAssignment("k"), Error);
 }
 
+TEST(SystemOptionsNames, AssignmentsOverTheDefaultsGiveTheOptionsBack) {
+  SystemOptions options;
+  options.deformation.k = 3;
+  options.mapping.dba_window = 7;
+  options.run.init = "depth";
+  const std::vector<std::string> assignments = AssignmentsOverDefaults(options);
+  EXPECT_EQ(assignments, (std::vector<std::string>{"deformation.k=3.0", "mapping.dba_window=7", "run.init=depth"}));
+  EXPECT_EQ(Json(WithAssignments(SystemOptions{}, assignments)), Json(options));
+  EXPECT_TRUE(AssignmentsOverDefaults(SystemOptions{}).empty());
+}
+
 TEST(SystemOptionsFile, PartialOptionsOverTheDefaultsAndUnknownKeysRejected) {
   const fs::path folder = UniqueTempFolder("nrslam_options_file");
   fs::create_directories(folder);

@@ -54,7 +54,8 @@ int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem:
 int main(int argc, char** argv) {
   CLI::App app{"Evaluate NR-SLAM over a manifest of sequences"};
   app.require_subcommand(0, 1);
-  std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline;
+  std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline,
+      config_path;
   std::vector<std::string> assignments, sweeps;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   double tolerance = 0.10;
@@ -64,6 +65,8 @@ int main(int argc, char** argv) {
   app.add_option("--cache", cache, "where presets are rendered and datasets imported, shared between evaluations")
       ->capture_default_str();
   app.add_option("--jobs,-j", jobs, "processes at once")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--config", config_path, "JSON options for every sequence (a run's config.json or an options "
+                                          "object): those that differ from the defaults, before --set");
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");
   app.add_option("--sweep", sweeps, "run a grid: --sweep k=0.5,1.1,2 --sweep max_degree_D=3,5,10");
   app.add_option("--emit-jobs", emit_jobs, "write one shell command per run to FILE (for GNU parallel, Slurm) "
@@ -84,6 +87,7 @@ int main(int argc, char** argv) {
     std::vector<nrslam::Sweep> grid;
     for (const std::string& sweep : sweeps) grid.push_back(nrslam::ParseSweep(sweep));
     std::vector<std::string> resolved;
+    if (!config_path.empty()) resolved = nrslam::AssignmentsOverDefaults(nrslam::SystemOptionsFromFile(config_path));
     for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
     if (merge->parsed()) {
       // Runs of the same plan executed elsewhere: gather their run folders under --out.

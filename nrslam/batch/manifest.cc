@@ -9,10 +9,6 @@
 
 namespace nrslam {
 
-std::string Assignment(const std::string& path, const Json& value) {
-  return path + "=" + (value.is_string() ? value.get<std::string>() : value.dump());
-}
-
 namespace {
 
 // The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).

@@ -46,7 +46,5 @@ struct Manifest {
 // Throws Error naming the manifest, the sequence and what is wrong.
 Manifest LoadManifest(const std::filesystem::path& file);
 
-// "path=value" for a JSON value (strings unquoted).
-std::string Assignment(const std::string& path, const Json& value);
 
 }  // namespace nrslam

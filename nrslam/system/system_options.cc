@@ -20,6 +20,18 @@ SystemOptions SystemOptionsFromFile(const std::filesystem::path& file) {
   return OptionsFromJson<SystemOptions>(run_config ? given.at("options") : given, file.string());
 }
 
+std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options) {
+  const Json given = options, defaults = SystemOptions{};
+  std::vector<std::string> assignments;
+  for (const std::string& path : LeafPaths(defaults)) {
+    std::string pointer = "/" + path;
+    std::replace(pointer.begin(), pointer.end(), '.', '/');
+    const Json& value = given.at(Json::json_pointer(pointer));
+    if (value != defaults.at(Json::json_pointer(pointer))) assignments.push_back(Assignment(path, value));
+  }
+  return assignments;
+}
+
 std::string ResolveRunOption(const std::string& name) {
   static const std::vector<std::string> paths = LeafPaths(Json(SystemOptions{}));
   if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "nrslam/deformation/deformation_options.h"
 #include "nrslam/eval/depth_evaluation.h"
@@ -56,6 +57,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SystemOptions, run, frontend, de
 // bare options object, whole or partial. Unknown keys are errors, so a saved run is repeated
 // exactly or not at all.
 SystemOptions SystemOptionsFromFile(const std::filesystem::path& file);
+// "path=value" for every option that differs from its default: applied to the defaults they
+// give `options` back. How a file's configuration joins a batch's --set list.
+std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options);
 
 // A run option's full path from a full path or a unique last name ("k" → "deformation.k");
 // throws Error listing the candidates when unknown or ambiguous.

@@ -75,6 +75,10 @@ Json ParseLike(const Json& existing, const std::string& text, const std::string&
 
 }  // namespace
 
+std::string Assignment(const std::string& path, const Json& value) {
+  return path + "=" + (value.is_string() ? value.get<std::string>() : value.dump());
+}
+
 std::vector<std::string> LeafPaths(const Json& config) {
   std::vector<std::string> paths;
   CollectLeafPaths(config, "", &paths);

@@ -27,6 +27,9 @@ void RejectUnknownKeys(const Json& given, const Json& reference, const std::stri
 // for arrays). Throws Error with the known keys when the path is unknown.
 void ApplyAssignment(Json& config, const std::string& assignment);
 
+// "path=value" for a JSON value (strings unquoted): the inverse of ApplyAssignment.
+std::string Assignment(const std::string& path, const Json& value);
+
 // Parses a JSON file; throws Error "cannot open FILE" or "FILE is not valid JSON (why)".
 Json ReadJsonFile(const std::filesystem::path& file);
 
