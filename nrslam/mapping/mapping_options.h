@@ -11,7 +11,10 @@ namespace nrslam {
 
 struct InitialisationOptions {
   int min_tracks = 100;              // fewer tracks from the reference frame: restart from this frame
-  int max_reference_age = 30;        // frames; an older reference is replaced by the current frame
+  // Frames; an older reference is replaced by the current frame. The reference's 30 never let
+  // the fisheye lap-lobes initialise (the camera creeps at 66–130 mm depth); 60 does, at frame
+  // 58, and changes nothing that initialised within 30 (README, "Mapping").
+  int max_reference_age = 60;
   int ransac_iterations = 200;       // 8-point samples (the reference draws 16 bucketed ones)
   double epipolar_threshold_px = 2.5;  // E inlier: angle to the epipolar plane, in pixel angles (the reference's 0.005 rad at 0.002 rad/px)
   double min_parallax_px = 5;        // a point's rays must differ by this many pixel angles
