@@ -46,5 +46,4 @@ struct Manifest {
 // Throws Error naming the manifest, the sequence and what is wrong.
 Manifest LoadManifest(const std::filesystem::path& file);
 
-
 }  // namespace nrslam

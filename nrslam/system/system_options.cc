@@ -21,15 +21,7 @@ SystemOptions SystemOptionsFromFile(const std::filesystem::path& file) {
 }
 
 std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options) {
-  const Json given = options, defaults = SystemOptions{};
-  std::vector<std::string> assignments;
-  for (const std::string& path : LeafPaths(defaults)) {
-    std::string pointer = "/" + path;
-    std::replace(pointer.begin(), pointer.end(), '.', '/');
-    const Json& value = given.at(Json::json_pointer(pointer));
-    if (value != defaults.at(Json::json_pointer(pointer))) assignments.push_back(Assignment(path, value));
-  }
-  return assignments;
+  return ChangedAssignments(Json(SystemOptions{}), Json(options));
 }
 
 std::string ResolveRunOption(const std::string& name) {

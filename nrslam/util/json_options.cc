@@ -16,6 +16,16 @@ void CollectLeafPaths(const Json& node, const std::string& prefix, std::vector<s
   }
 }
 
+void CollectChanged(const Json& base, const Json& changed, const std::string& prefix, std::vector<std::string>* out) {
+  if (!base.is_object()) {
+    if (changed != base) out->push_back(Assignment(prefix, changed));
+    return;
+  }
+  for (auto it = base.begin(); it != base.end(); ++it) {
+    CollectChanged(it.value(), changed.at(it.key()), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
+  }
+}
+
 void CollectUnknown(const Json& given, const Json& reference, const std::string& prefix,
                     std::vector<std::string>* unknown) {
   if (!given.is_object() || !reference.is_object()) return;
@@ -77,6 +87,12 @@ Json ParseLike(const Json& existing, const std::string& text, const std::string&
 
 std::string Assignment(const std::string& path, const Json& value) {
   return path + "=" + (value.is_string() ? value.get<std::string>() : value.dump());
+}
+
+std::vector<std::string> ChangedAssignments(const Json& base, const Json& changed) {
+  std::vector<std::string> assignments;
+  CollectChanged(base, changed, "", &assignments);
+  return assignments;
 }
 
 std::vector<std::string> LeafPaths(const Json& config) {

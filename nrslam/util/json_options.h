@@ -30,6 +30,10 @@ void ApplyAssignment(Json& config, const std::string& assignment);
 // "path=value" for a JSON value (strings unquoted): the inverse of ApplyAssignment.
 std::string Assignment(const std::string& path, const Json& value);
 
+// "path=value" for every leaf (as LeafPaths counts them) where `changed` differs from `base`;
+// applied to `base` they give `changed`. Both must have the same keys.
+std::vector<std::string> ChangedAssignments(const Json& base, const Json& changed);
+
 // Parses a JSON file; throws Error "cannot open FILE" or "FILE is not valid JSON (why)".
 Json ReadJsonFile(const std::filesystem::path& file);
 
