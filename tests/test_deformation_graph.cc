@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
+#include <random>
 
 #include "nrslam/deformation/deformation_graph.h"
 #include "nrslam/util/error.h"
@@ -151,6 +153,47 @@ TEST(DeformationGraph, FlagsPointsLeftWithTooFewEdges) {
   EXPECT_EQ(graph.GoodEdgeCount(1), 0);
   EXPECT_TRUE(graph.IsWeaklyConnected(1));
   EXPECT_THROW(graph.set_sigma(0.0), Error);
+}
+
+// The graph keeps per-point counts and a packed copy of the weights for speed; after any
+// sequence of updates they must say what the edge records themselves say.
+TEST(DeformationGraph, CountsAndBestEdgesAgreeWithTheEdgeRecordsAfterUpdates) {
+  DeformationModelOptions options;
+  options.max_degree_D = 4;
+  options.stretch_threshold = 0.3;
+  DeformationGraph graph(options, 1.5);
+  Positions positions;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(0.0, 3.0), jitter(-0.25, 0.25);
+  for (PointId id = 0; id < 40; ++id) positions.at[id] = {coordinate(random), coordinate(random), coordinate(random)};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  for (int step = 0; step < 12; ++step) {
+    for (auto& [id, position] : positions.at) position += Eigen::Vector3d(jitter(random), jitter(random), jitter(random));
+    for (const PointId id : positions.Ids()) graph.UpdatePoint(id, positions.Lookup());
+    if (step == 5) graph.set_sigma(1.0);
+    if (step == 8) graph.ResetRestShape({0, 1, 2, 3, 4, 5}, positions.Lookup());
+  }
+  ASSERT_GT(graph.pruned_count(), 0u);
+  ASSERT_LT(graph.pruned_count(), graph.edge_count());
+  for (const PointId id : positions.Ids()) {
+    int unpruned = 0;
+    std::vector<std::pair<double, PointId>> usable;
+    for (size_t e = 0; e < graph.edge_count(); ++e) {
+      const GraphEdge& edge = graph.edge(static_cast<int>(e));
+      if (edge.a != id && edge.b != id) continue;
+      if (!edge.pruned) ++unpruned;
+      if (!edge.pruned && edge.weight >= options.min_edge_weight) usable.emplace_back(-edge.weight, edge.a == id ? edge.b : edge.a);
+    }
+    EXPECT_EQ(graph.GoodEdgeCount(id), unpruned);
+    std::sort(usable.begin(), usable.end());
+    usable.resize(std::min<size_t>(usable.size(), 4));
+    const auto best = graph.BestNeighbours(id);
+    ASSERT_EQ(best.size(), usable.size());
+    for (size_t i = 0; i < best.size(); ++i) {
+      EXPECT_EQ(best[i].id, usable[i].second);
+      EXPECT_EQ(best[i].weight, -usable[i].first);
+    }
+  }
 }
 
 }  // namespace

@@ -17,7 +17,30 @@ DeformationGraph::DeformationGraph(const DeformationModelOptions& options, doubl
 void DeformationGraph::set_sigma(double sigma) {
   if (!(sigma > 0) || !std::isfinite(sigma)) throw Error("deformation graph: sigma must be > 0");
   sigma_ = sigma;
-  for (GraphEdge& edge : edges_) edge.weight = WeightOf(edge.max_length);
+  for (size_t index = 0; index < edges_.size(); ++index) {
+    edges_[index].weight = WeightOf(edges_[index].max_length);
+    UpdateRanking(static_cast<int>(index));
+  }
+}
+
+void DeformationGraph::UpdateRanking(int index) {
+  const GraphEdge& edge = edges_[index];
+  ranking_weight_[index] = edge.pruned || edge.weight < options_.min_edge_weight ? -1.0 : edge.weight;
+}
+
+void DeformationGraph::Remeasure(int index, double length) {
+  GraphEdge& edge = edges_[index];
+  edge.min_length = std::min(edge.min_length, length);
+  if (length > edge.max_length) {  // the weight follows the longest length (an exp: only when it grows)
+    edge.max_length = length;
+    edge.weight = WeightOf(length);
+  }
+  if (!edge.pruned && (edge.max_length - edge.min_length) / edge.min_length > options_.stretch_threshold) {
+    edge.pruned = true;
+    --nodes_[edge.a].unpruned;
+    --nodes_[edge.b].unpruned;
+  }
+  UpdateRanking(index);
 }
 
 double DeformationGraph::WeightOf(double max_length) const {
@@ -35,10 +58,10 @@ std::optional<int> DeformationGraph::FindEdge(PointId a, PointId b) const {
   const GraphEdge& edge = edges_[candidates->second];
   if ((edge.a == a && edge.b == b) || (edge.a == b && edge.b == a)) return candidates->second;
   // A key collision (only possible for ids beyond 2³²): fall back to the adjacency list.
-  const auto list = adjacency_.find(a);
-  if (list == adjacency_.end()) return std::nullopt;
-  for (int index : list->second) {
-    if (edges_[index].a == b || edges_[index].b == b) return index;
+  const auto node = nodes_.find(a);
+  if (node == nodes_.end()) return std::nullopt;
+  for (const Incidence& incidence : node->second.edges) {
+    if (incidence.other == b) return incidence.edge;
   }
   return std::nullopt;
 }
@@ -48,8 +71,13 @@ void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
   if (!(length > 0) || !std::isfinite(length)) return;  // coincident or invalid points: no direction to regularise
   const int index = static_cast<int>(edges_.size());
   edges_.push_back({a, b, length, length, length, WeightOf(length), false});
-  adjacency_[a].push_back(index);
-  adjacency_[b].push_back(index);
+  ranking_weight_.push_back(0.0);
+  UpdateRanking(index);
+  for (const auto& [from, to] : {std::pair(a, b), std::pair(b, a)}) {
+    Node& node = nodes_[from];
+    node.edges.push_back({to, index});
+    ++node.unpruned;
+  }
   edge_index_.emplace(PairKey(a, b), index);
 }
 
@@ -71,40 +99,32 @@ void DeformationGraph::ConnectCovisible(const std::vector<PointId>& new_points, 
 }
 
 void DeformationGraph::UpdatePoint(PointId point, const PositionLookup& position) {
-  const auto list = adjacency_.find(point);
-  if (list == adjacency_.end()) return;
+  const auto node = nodes_.find(point);
+  if (node == nodes_.end()) return;
   const auto here = position(point);
   if (!here) return;
-  for (int index : list->second) {
-    GraphEdge& edge = edges_[index];
-    const auto there = position(edge.a == point ? edge.b : edge.a);
-    if (!there) continue;
-    const double length = (*here - *there).norm();
-    edge.min_length = std::min(edge.min_length, length);
-    if (length > edge.max_length) {  // the weight follows the longest length (an exp: only when it grows)
-      edge.max_length = length;
-      edge.weight = WeightOf(length);
-    }
-    if ((edge.max_length - edge.min_length) / edge.min_length > options_.stretch_threshold) edge.pruned = true;
+  for (const Incidence& incidence : node->second.edges) {
+    const auto there = position(incidence.other);
+    if (there) Remeasure(incidence.edge, (*here - *there).norm());
   }
 }
 
 void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const PositionLookup& position) {
   const std::unordered_set<PointId> chosen(points.begin(), points.end());
   for (PointId point : points) {
-    const auto list = adjacency_.find(point);
+    const auto node = nodes_.find(point);
     const auto here = position(point);
-    if (list == adjacency_.end() || !here) continue;
-    for (int index : list->second) {
-      GraphEdge& edge = edges_[index];
-      const PointId other = edge.a == point ? edge.b : edge.a;
+    if (node == nodes_.end() || !here) continue;
+    for (const auto& [other, index] : node->second.edges) {
       if (other < point && chosen.count(other)) continue;  // done from the other end
       if (!chosen.count(other)) continue;
       const auto there = position(other);
       if (!there) continue;
+      GraphEdge& edge = edges_[index];
       const double length = (*here - *there).norm();
       edge.rest_length = edge.min_length = edge.max_length = length;
       edge.weight = WeightOf(length);
+      UpdateRanking(index);
     }
   }
 }
@@ -112,14 +132,13 @@ void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const 
 std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
                                                              const std::function<bool(PointId)>& eligible) const {
   std::vector<GraphNeighbour> neighbours;
-  const auto list = adjacency_.find(point);
-  if (list == adjacency_.end()) return neighbours;
-  for (int index : list->second) {
-    const GraphEdge& edge = edges_[index];
-    if (edge.pruned || edge.weight < options_.min_edge_weight) continue;
-    const PointId other = edge.a == point ? edge.b : edge.a;
+  const auto node = nodes_.find(point);
+  if (node == nodes_.end()) return neighbours;
+  for (const auto& [other, index] : node->second.edges) {
+    const double weight = ranking_weight_[index];
+    if (weight < 0.0) continue;
     if (eligible && !eligible(other)) continue;
-    neighbours.push_back({other, index, edge.weight});
+    neighbours.push_back({other, index, weight});
   }
   const size_t keep = std::min(neighbours.size(), static_cast<size_t>(options_.max_degree_D));
   // Ties broken by id so the choice never depends on insertion order.
@@ -132,10 +151,8 @@ std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
 }
 
 int DeformationGraph::GoodEdgeCount(PointId point) const {
-  const auto list = adjacency_.find(point);
-  if (list == adjacency_.end()) return 0;
-  return static_cast<int>(std::count_if(list->second.begin(), list->second.end(),
-                                        [&](int index) { return !edges_[index].pruned; }));
+  const auto node = nodes_.find(point);
+  return node == nodes_.end() ? 0 : node->second.unpruned;
 }
 
 size_t DeformationGraph::pruned_count() const {

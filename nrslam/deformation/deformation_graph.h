@@ -67,6 +67,7 @@ class DeformationGraph {
   // neighbours that pass `eligible` (all if empty): e.g. only the points tracked this frame,
   // so lost neighbours do not use up the point's D regularisers.
   std::vector<GraphNeighbour> BestNeighbours(PointId point, const std::function<bool(PointId)>& eligible = {}) const;
+  // Unpruned edges of the point (kept as a count: asked for every point every frame).
   int GoodEdgeCount(PointId point) const;
   // Fewer than min_good_edges unpruned edges left: the point's deformation is unconstrained.
   bool IsWeaklyConnected(PointId point) const { return GoodEdgeCount(point) < options_.min_good_edges; }
@@ -79,11 +80,25 @@ class DeformationGraph {
  private:
   DeformationModelOptions options_;
   double sigma_;
+  struct Incidence {
+    PointId other;
+    int edge;
+  };
+  struct Node {
+    std::vector<Incidence> edges;
+    int unpruned = 0;
+  };
   std::vector<GraphEdge> edges_;
-  std::unordered_map<PointId, std::vector<int>> adjacency_;
+  // Per edge, b if it may regularise (unpruned, b >= min_edge_weight), else −1: what the
+  // best-D choice reads for each of a point's edges, packed densely because a complete graph
+  // gives every point hundreds of them and the choice is made for every point every frame.
+  std::vector<double> ranking_weight_;
+  std::unordered_map<PointId, Node> nodes_;
   std::unordered_map<uint64_t, int> edge_index_;  // keyed by the unordered pair
 
   double WeightOf(double max_length) const;
+  void Remeasure(int index, double length);  // a new observed length: d_min, d_max, b, pruning
+  void UpdateRanking(int index);
   static uint64_t PairKey(PointId a, PointId b);
 };
 
