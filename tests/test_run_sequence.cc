@@ -416,5 +416,33 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   fs::remove_all(folder);
 }
 
+// Frames are read ahead of the tracker and depth maps written behind it (run_sequence.cc): a
+// frame that cannot be read must still be the one recorded as failed, and the run go on.
+TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
+  const fs::path folder = UniqueTempFolder("nrslam_corrupt_frame");
+  fs::remove_all(folder);
+  SimulateSmall("sim-0", 10, 320, 240, folder);
+  // Truncated after its header: the sequence opens (headers are checked up front), and only
+  // decoding the frame fails.
+  const fs::path broken = folder / "rgb" / "000006.png";
+  fs::resize_file(broken, 200);
+  SystemOptions options = TrackingExperiment();
+  options.run.reinitialise_after_loss = true;
+  const RunSummary summary = RunSequence(folder, options, folder / "run");
+  EXPECT_EQ(summary.frames_tracked, 9);
+  EXPECT_EQ(summary.frames_lost, 1);
+  std::ifstream metrics(folder / "run" / "metrics.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(metrics, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 11u);
+  for (int frame = 0; frame < 10; ++frame) {
+    const std::string& row = rows[static_cast<size_t>(frame) + 1];
+    EXPECT_EQ(row.rfind(std::to_string(frame) + (frame == 6 ? ",lost," : ",tracking,"), 0), 0u) << row;
+    EXPECT_EQ(fs::exists(folder / "run" / "depth" / FrameFileName(frame)), frame != 6) << frame;
+  }
+  EXPECT_NE(rows[7].find("000006.png"), std::string::npos) << rows[7];
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace nrslam

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <future>
 #include <iomanip>
 #include <sstream>
 
@@ -67,6 +68,59 @@ cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, co
   return depth;
 }
 
+struct FrameImages {
+  cv::Mat bgr, mask, depth_mm;
+};
+
+FrameImages ReadFrame(const SequenceReader& reader, int frame) {
+  FrameImages images;
+  images.bgr = reader.ReadRgb(frame);
+  images.mask = reader.ReadMask(frame);
+  if (reader.has_depth()) images.depth_mm = reader.ReadDepthMm(frame);
+  return images;
+}
+
+// Decoding a frame's PNGs and encoding its depth map are a fifth of a tracking run's time and
+// depend on nothing the tracker computes, so they run beside it, on the other core: the next
+// frame is read while this one is processed, and each depth map is written while the next
+// frame is. Results are the same as when done in line; only the wall-clock time changes.
+class FrameIo {
+ public:
+  FrameIo(const SequenceReader& reader, int first, int last) : reader_(reader), last_(last) { Prefetch(first); }
+  ~FrameIo() {
+    // An unwinding run must not leave threads behind; their errors no longer matter.
+    if (next_.valid()) next_.wait();
+    if (write_.valid()) write_.wait();
+  }
+
+  // The frame's images; errors of reading it (a missing or corrupt file) are thrown here.
+  FrameImages Take(int frame) {
+    std::future<FrameImages> current = std::move(next_);
+    Prefetch(frame + 1);
+    return current.get();
+  }
+
+  // Writes the image after the previous write has finished; throws if that one failed.
+  void Write(const fs::path& path, cv::Mat image) {
+    Finish();
+    write_ = std::async(std::launch::async, [path, image = std::move(image)] {
+      if (!cv::imwrite(path.string(), image)) throw Error("cannot write " + path.string());
+    });
+  }
+  void Finish() {
+    if (write_.valid()) write_.get();
+  }
+
+ private:
+  void Prefetch(int frame) {
+    if (frame < last_) next_ = std::async(std::launch::async, ReadFrame, std::cref(reader_), frame);
+  }
+  const SequenceReader& reader_;
+  int last_;
+  std::future<FrameImages> next_;
+  std::future<void> write_;
+};
+
 }  // namespace
 
 RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, const fs::path& out,
@@ -118,15 +172,17 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
   const auto start = Clock::now();
+  FrameIo io(reader, first, last);
   for (int frame = first; frame < last; ++frame) {
     FrameResult result;
     result.frame = frame;
     MappingReport mapping;
     cv::Mat depth_mm;
     try {
-      const cv::Mat bgr = reader.ReadRgb(frame);
-      const cv::Mat mask = reader.ReadMask(frame);
-      if (reader.has_depth()) depth_mm = reader.ReadDepthMm(frame);
+      const FrameImages images = io.Take(frame);
+      const cv::Mat& bgr = images.bgr;
+      const cv::Mat& mask = images.mask;
+      depth_mm = images.depth_mm;
       if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask);
         if (result.state == TrackingState::kLost) {
@@ -198,7 +254,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       const double to_mm = evaluation.evaluated ? evaluation.scale : 1.0;
       for (size_t i = 0; i < result.points.size(); ++i) splats.emplace_back(result.points[i].pixel, to_mm * depth_points[i].depth);
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
-      cv::imwrite((out / "depth" / FrameFileName(frame)).string(), SplatDepth(splats, size, reader.info().depth_unit_mm));
+      io.Write(out / "depth" / FrameFileName(frame), SplatDepth(splats, size, reader.info().depth_unit_mm));
     } else if (summary.init_frame >= 0) {
       ++summary.frames_lost;
     }
@@ -220,6 +276,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       progress(frame + 1 - first, summary.frames_total, line.str());
     }
   }
+  io.Finish();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.fps = summary.frames_total / std::max(seconds, 1e-9);
   summary.ms_initialisation = ms_initialisation / summary.frames_total;
