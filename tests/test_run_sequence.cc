@@ -2,6 +2,7 @@
 // deformable tracking), checked against the simulator's ground truth.
 #include <gtest/gtest.h>
 
+#include <omp.h>
 #include <opencv2/videoio.hpp>
 
 #include <filesystem>
@@ -317,6 +318,19 @@ TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {
   EXPECT_GT(outcome.deformable_candidates, reference.deformable_candidates);
   EXPECT_GT(adaptive.deformable_candidates, reference.deformable_candidates);
   EXPECT_GT(adaptive.new_points, reference.new_points);
+}
+
+// New points are triangulated on every core (mapper.cc); the map must not depend on how many.
+TEST(MonocularRun, TriangulationOnTwoThreadsGivesTheSameRunAsOne) {
+  omp_set_num_threads(1);
+  const MonocularOutcome one = RunMonocular("sim-3", SystemOptions{});
+  omp_set_num_threads(2);
+  const MonocularOutcome two = RunMonocular("sim-3", SystemOptions{});
+  ASSERT_GT(one.deformable_candidates, 0);
+  EXPECT_EQ(two.deformable_candidates, one.deformable_candidates);
+  EXPECT_EQ(two.new_points, one.new_points);
+  EXPECT_EQ(two.summary.map_points, one.summary.map_points);
+  EXPECT_EQ(two.summary.rmse_mm, one.summary.rmse_mm);  // exactly: the same points, the same order
 }
 
 TEST(DepthMappingRun, StarvingMapRuleLeavesItAlone) {

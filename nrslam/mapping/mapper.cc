@@ -286,68 +286,76 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrac
   return newest.Inverse() * (ray * along);
 }
 
+Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation& candidate, bool shortest_gate,
+                                                     double map_scale) const {
+  CandidatePoints points;
+  const Snapshot& newest = buffer_.back();
+  const double crowding2 = options_.crowding_radius_px * options_.crowding_radius_px;
+  const double radius2 = options_.neighbour_radius_px * options_.neighbour_radius_px;
+  // Crowding gate and neighbours: the nearest tracked 3D points in the image.
+  std::vector<std::pair<double, PointId>> near;
+  for (const auto& [id, observation] : newest.points) {
+    const cv::Point2f offset = observation.first - candidate.pixel;
+    const double distance2 = offset.dot(offset);
+    if (distance2 < crowding2) return points;
+    if (distance2 <= radius2) near.emplace_back(distance2, id);
+  }
+  if (near.empty()) return points;
+  const size_t keep = std::min(near.size(), static_cast<size_t>(options_.neighbours));
+  std::partial_sort(near.begin(), near.begin() + keep, near.end());
+  std::vector<PointId> neighbours;
+  for (size_t i = 0; i < keep; ++i) neighbours.push_back(near[i].second);
+
+  CandidateTrack track;
+  for (const Snapshot& snapshot : buffer_) {
+    const auto it = snapshot.candidates.find(candidate.track_id);
+    if (it == snapshot.candidates.end()) continue;
+    track.frames.push_back(&snapshot);
+    track.pixels.push_back(ToEigen(it->second));
+  }
+  if (track.frames.size() < 2) return points;
+  // A new point lies on the surface its neighbours span: its depth now is within
+  // max_depth_ratio of theirs. Low parallax leaves a triangulated depth free to run off
+  // (measured on lap-lobes: points at 4 % of the median depth, which then drag the map).
+  double nearest = std::numeric_limits<double>::infinity(), farthest = 0;
+  for (PointId id : neighbours) {
+    const double z = (newest.cam_from_world * newest.points.at(id).second).z();
+    nearest = std::min(nearest, z);
+    farthest = std::max(farthest, z);
+  }
+  const auto plausible = [&](const Eigen::Vector3d& point) {
+    const double z = (newest.cam_from_world * point).z();
+    return z * options_.max_depth_ratio >= nearest && z <= options_.max_depth_ratio * farthest;
+  };
+  const std::optional<Triangulated> ends = TriangulatePair(track, 0, track.frames.size() - 1);
+  if (const auto point = TriangulateRigid(track, ends, map_scale); point && plausible(*point)) points.rigid = point;
+  if (!rigid_ && options_.deformable_triangulation &&
+      static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
+    const std::optional<Triangulated> gate = shortest_gate ? TriangulateShortestSpan(track) : ends;
+    if (const auto point = TriangulateDeformable(track, gate, neighbours, map_scale); point && plausible(*point)) {
+      points.deformable = point;
+    }
+  }
+  return points;
+}
+
 void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report) {
   const auto start = Clock::now();
   if (buffer_.size() < 2 || result.candidates.empty()) return;
-  const Snapshot& newest = buffer_.back();
   Map& map = tracker->mutable_map();
-  const double crowding2 = options_.crowding_radius_px * options_.crowding_radius_px;
-  const double radius2 = options_.neighbour_radius_px * options_.neighbour_radius_px;
-  std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
   const bool starving = two_view_map_ && static_cast<double>(result.points.size()) <
                                             options_.shortest_gate_below_fraction * static_cast<double>(start_points_);
   const bool shortest_gate = options_.deformable_gate_span == "shortest" || starving;
-  for (const CandidateObservation& candidate : result.candidates) {
-    // Crowding gate and neighbours: the nearest tracked 3D points in the image.
-    std::vector<std::pair<double, PointId>> near;
-    bool crowded = false;
-    for (const auto& [id, observation] : newest.points) {
-      const cv::Point2f offset = observation.first - candidate.pixel;
-      const double distance2 = offset.dot(offset);
-      if (distance2 < crowding2) {
-        crowded = true;
-        break;
-      }
-      if (distance2 <= radius2) near.emplace_back(distance2, id);
-    }
-    if (crowded || near.empty()) continue;
-    const size_t keep = std::min(near.size(), static_cast<size_t>(options_.neighbours));
-    std::partial_sort(near.begin(), near.begin() + keep, near.end());
-    std::vector<PointId> neighbours;
-    for (size_t i = 0; i < keep; ++i) neighbours.push_back(near[i].second);
-
-    CandidateTrack track;
-    for (const Snapshot& snapshot : buffer_) {
-      const auto it = snapshot.candidates.find(candidate.track_id);
-      if (it == snapshot.candidates.end()) continue;
-      track.frames.push_back(&snapshot);
-      track.pixels.push_back(ToEigen(it->second));
-    }
-    if (track.frames.size() < 2) continue;
-    // A new point lies on the surface its neighbours span: its depth now is within
-    // max_depth_ratio of theirs. Low parallax leaves a triangulated depth free to run off
-    // (measured on lap-lobes: points at 4 % of the median depth, which then drag the map).
-    double nearest = std::numeric_limits<double>::infinity(), farthest = 0;
-    for (PointId id : neighbours) {
-      const double z = (newest.cam_from_world * newest.points.at(id).second).z();
-      nearest = std::min(nearest, z);
-      farthest = std::max(farthest, z);
-    }
-    const auto plausible = [&](const Eigen::Vector3d& point) {
-      const double z = (newest.cam_from_world * point).z();
-      return z * options_.max_depth_ratio >= nearest && z <= options_.max_depth_ratio * farthest;
-    };
-    const std::optional<Triangulated> ends = TriangulatePair(track, 0, track.frames.size() - 1);
-    if (const auto point = TriangulateRigid(track, ends, map.scale()); point && plausible(*point)) {
-      rigid.emplace_back(candidate.track_id, *point);
-    }
-    if (!rigid_ && options_.deformable_triangulation &&
-        static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-      const std::optional<Triangulated> gate = shortest_gate ? TriangulateShortestSpan(track) : ends;
-      if (const auto point = TriangulateDeformable(track, gate, neighbours, map.scale()); point && plausible(*point)) {
-        deformable.emplace_back(candidate.track_id, *point);
-      }
-    }
+  // Each candidate is its own small problem: they are solved on every core, each into its own
+  // slot, and gathered in candidate order, so the outcome is the same as one at a time.
+  const int count = static_cast<int>(result.candidates.size());
+  std::vector<CandidatePoints> solved(result.candidates.size());
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int c = 0; c < count; ++c) solved[c] = TriangulateCandidate(result.candidates[c], shortest_gate, map.scale());
+  std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
+  for (int c = 0; c < count; ++c) {
+    if (solved[c].rigid) rigid.emplace_back(result.candidates[c].track_id, *solved[c].rigid);
+    if (solved[c].deformable) deformable.emplace_back(result.candidates[c].track_id, *solved[c].deformable);
   }
   report->rigid_candidates = static_cast<int>(rigid.size());
   report->deformable_candidates = static_cast<int>(deformable.size());

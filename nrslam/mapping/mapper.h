@@ -79,6 +79,13 @@ class Mapper {
   // Camera travel from the oldest to the newest keyframe over the newest one's median depth.
   double BaselineRatio(const std::deque<Keyframe>& keyframes) const;
   void Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report);
+  // One candidate's rigid and deformable points (either may be missing); reads only the
+  // buffer and the options, so candidates can be triangulated side by side.
+  struct CandidatePoints {
+    std::optional<Eigen::Vector3d> rigid, deformable;
+  };
+  CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, bool shortest_gate,
+                                       double map_scale) const;
   // Observation i's viewing ray, in the world frame.
   Eigen::Vector3d WorldRay(const CandidateTrack& track, size_t i) const;
   // The rays of observations a and b met in the middle, if both lie in front and it
