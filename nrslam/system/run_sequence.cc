@@ -87,11 +87,6 @@ FrameImages ReadFrame(const SequenceReader& reader, int frame) {
 class FrameIo {
  public:
   FrameIo(const SequenceReader& reader, int first, int last) : reader_(reader), last_(last) { Prefetch(first); }
-  ~FrameIo() {
-    // An unwinding run must not leave threads behind; their errors no longer matter.
-    if (next_.valid()) next_.wait();
-    if (write_.valid()) write_.wait();
-  }
 
   // The frame's images; errors of reading it (a missing or corrupt file) are thrown here.
   FrameImages Take(int frame) {
@@ -117,6 +112,8 @@ class FrameIo {
   }
   const SequenceReader& reader_;
   int last_;
+  // Futures of std::async wait for their thread when destroyed, so a run that unwinds early
+  // leaves no thread behind.
   std::future<FrameImages> next_;
   std::future<void> write_;
 };
