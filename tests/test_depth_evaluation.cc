@@ -1,6 +1,7 @@
 // Known-answer tests of the evaluator (design README §5).
 #include <gtest/gtest.h>
 
+#include "nrslam/eval/common_points.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/util/error.h"
 
@@ -103,6 +104,37 @@ TEST(DepthEvaluation, SequenceAggregates) {
   EXPECT_NEAR(metrics.rmse_mm, 7.0 / 3.0, 1e-12);
   EXPECT_NEAR(metrics.rmse_median_mm, 2.0, 1e-12);
   EXPECT_NEAR(metrics.rmse_pooled_mm, std::sqrt(21.0 / 3.0), 1e-12);
+}
+
+// Run a keeps ten exact points and ten bad ones; run b only the ten exact ones (and one of its
+// own). On their own points a scores badly and b perfectly; on the common points both are exact.
+TEST(CommonPoints, BothRunsAreScoredOnThePointsTheyShare) {
+  cv::Mat depth(40, 60, CV_32F);
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) depth.at<float>(y, x) = 80.0f + x;  // a slanted plane, mm
+  }
+  const auto truth = [&](int x, int y) { return static_cast<double>(depth.at<float>(y, x)); };
+  RunPoints a, b;
+  for (int id = 0; id < 20; ++id) {
+    const int x = 2 + 2 * id, y = 5 + id;
+    const double bad = id >= 10 ? (id % 2 ? 8.0 : -8.0) : 0.0;  // mm, far beyond the 5 % trimmed
+    a[3][id] = {cv::Point2d(x, y), (truth(x, y) + bad) / 2.0};  // map units: 2 mm each
+    if (id < 10) b[3][id] = {cv::Point2d(x, y), truth(x, y) * 3.0};
+  }
+  b[3][100] = {cv::Point2d(50, 30), truth(50, 30) * 3.0};
+  a[4] = a[3];  // a frame b does not report: not compared
+  b[5] = b[3];
+  a[5][0] = a[3][0];  // a frame with a single common point: too few to evaluate, not compared
+  const CommonPointsComparison comparison =
+      CompareOnCommonPoints(a, b, [&](int) { return depth; }, EvaluationOptions{});
+  EXPECT_EQ(comparison.frames, 1);
+  EXPECT_DOUBLE_EQ(comparison.mean_points_a, 20);
+  EXPECT_DOUBLE_EQ(comparison.mean_points_b, 11);
+  EXPECT_DOUBLE_EQ(comparison.mean_common_points, 10);
+  EXPECT_GT(comparison.a_own.rmse_mm, 4.0);
+  EXPECT_NEAR(comparison.b_own.rmse_mm, 0.0, 1e-9);
+  EXPECT_NEAR(comparison.a_common.rmse_mm, 0.0, 1e-9);
+  EXPECT_NEAR(comparison.b_common.rmse_mm, 0.0, 1e-9);
 }
 
 }  // namespace

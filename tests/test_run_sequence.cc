@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "temp_folder.h"
+#include "nrslam/batch/run_folder.h"
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/deformation/deformation_graph.h"
 #include "nrslam/eval/depth_evaluation.h"
@@ -126,6 +127,27 @@ TEST_F(RunSequenceTest, SummaryRmseIsRecomputableFromPointsCsvAndGroundTruth) {
 }
 
 // A run folder's config.json repeats the run: the same options, and the same trajectory.
+// A run compared with itself shares every point: the common-point score is its own summary's.
+TEST_F(RunSequenceTest, ComparedWithItselfACommonPointScoreIsItsOwnSummary) {
+  const CommonPointsComparison comparison = CompareRunFolders(*base_ / "run", *base_ / "run");
+  EXPECT_EQ(comparison.frames, summary_->frames_evaluated);
+  EXPECT_DOUBLE_EQ(comparison.mean_common_points, comparison.mean_points_a);
+  // points.csv holds 6 significant digits: the scores match the summary to about that.
+  EXPECT_NEAR(comparison.a_own.rmse_mm, summary_->rmse_mm, 1e-6);
+  EXPECT_NEAR(comparison.a_common.rmse_mm, summary_->rmse_mm, 1e-6);
+  EXPECT_NEAR(comparison.b_common.rmse_mm, summary_->rmse_mm, 1e-6);
+  EXPECT_EQ(comparison.a_common.rmse_mm, comparison.a_own.rmse_mm);
+  // Runs of different sequences are refused, not compared.
+  const fs::path other = *base_ / "other_run";
+  fs::create_directories(other);
+  nlohmann::json config;
+  std::ifstream(*base_ / "run" / "config.json") >> config;
+  config["sequence"] = (*base_ / "elsewhere").string();
+  std::ofstream(other / "config.json") << config.dump();
+  fs::copy_file(*base_ / "run" / "points.csv", other / "points.csv");
+  EXPECT_THROW(CompareRunFolders(*base_ / "run", other), Error);
+}
+
 TEST_F(RunSequenceTest, SavedConfigRepeatsTheRun) {
   const SystemOptions loaded = SystemOptionsFromFile(*base_ / "run" / "config.json");
   EXPECT_EQ(Json(loaded), Json(TrackingExperiment()));

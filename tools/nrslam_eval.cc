@@ -1,7 +1,8 @@
 // nrslam_eval: runs NR-SLAM over every sequence of a manifest (each in its own process),
 // with optional parameter sweeps, prints the results table, writes results.json/.csv, and
 // checks or writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
-// result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere).
+// result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere); `nrslam_eval
+// compare RUN_A RUN_B` scores two runs of one sequence on the points both report.
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -12,7 +13,10 @@
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
+#include "nrslam/batch/run_folder.h"
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/error.h"
+#include "nrslam/util/text_table.h"
 
 namespace {
 
@@ -49,6 +53,20 @@ int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem:
   return code;
 }
 
+int Compare(const std::filesystem::path& a, const std::filesystem::path& b) {
+  const nrslam::CommonPointsComparison comparison = nrslam::CompareRunFolders(a, b);
+  if (comparison.frames == 0) throw nrslam::Error("no frame that both runs report could be evaluated");
+  std::cout << comparison.frames << " frame(s) both runs report; " << nrslam::FormatFixed(comparison.mean_common_points, 0)
+            << " points per frame in common\n\n";
+  nrslam::TextTable table({"run", "points/frame", "own RMSE mm", "common RMSE mm"});
+  table.AddRow({a.string(), nrslam::FormatFixed(comparison.mean_points_a, 0), nrslam::FormatFixed(comparison.a_own.rmse_mm, 3),
+                nrslam::FormatFixed(comparison.a_common.rmse_mm, 3)});
+  table.AddRow({b.string(), nrslam::FormatFixed(comparison.mean_points_b, 0), nrslam::FormatFixed(comparison.b_own.rmse_mm, 3),
+                nrslam::FormatFixed(comparison.b_common.rmse_mm, 3)});
+  table.Print(std::cout);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,9 +98,14 @@ int main(int argc, char** argv) {
   std::string merge_manifest;
   merge->add_option("manifest", merge_manifest, "the manifest the jobs were emitted from")->required();
   merge->add_option("folders", merge_folders, "result folders to merge (default: --out)");
+  CLI::App* compare = app.add_subcommand("compare", "score two run folders of one sequence (e.g. deformable and "
+                                                    "rigid from the same depth map) on the points both report");
+  std::vector<std::string> compared;
+  compare->add_option("runs", compared, "two run folders")->required()->expected(2);
   CLI11_PARSE(app, argc, argv);
 
   try {
+    if (compare->parsed()) return Compare(compared[0], compared[1]);
     const nrslam::Programs programs = SiblingPrograms();
     std::vector<nrslam::Sweep> grid;
     for (const std::string& sweep : sweeps) grid.push_back(nrslam::ParseSweep(sweep));

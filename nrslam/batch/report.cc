@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/svg_plot.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/io/sequence_reader.h"
@@ -23,39 +24,6 @@ std::string Slug(const RunResult& result) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
   }
   return slug;
-}
-
-// metrics.csv rows by column name (the runner's own CSV: no quoted commas but in `note`).
-std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw Error("cannot read " + file.string());
-  std::vector<std::string> header;
-  std::vector<std::map<std::string, std::string>> rows;
-  std::string line;
-  while (std::getline(stream, line)) {
-    std::vector<std::string> fields;
-    std::stringstream split(line);
-    std::string field;
-    while (std::getline(split, field, ',')) fields.push_back(field);
-    if (header.empty()) {
-      header = fields;
-      continue;
-    }
-    std::map<std::string, std::string> row;
-    for (size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-double Number(const std::map<std::string, std::string>& row, const std::string& key) {
-  const auto found = row.find(key);
-  if (found == row.end() || found->second.empty()) return std::nan("");
-  try {
-    return std::stod(found->second);
-  } catch (const std::exception&) {
-    return std::nan("");
-  }
 }
 
 // Camera positions of a TUM file by timestamp, in the ground truth's world: the estimate's

@@ -1,0 +1,72 @@
+#include "nrslam/batch/run_folder.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/system/system_options.h"
+#include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
+
+namespace nrslam {
+
+std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  if (!stream) throw Error("cannot read " + file.string());
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+  std::string line;
+  while (std::getline(stream, line)) {
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    std::string field;
+    while (std::getline(split, field, ',')) fields.push_back(field);
+    if (header.empty()) {
+      header = fields;
+      continue;
+    }
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+double Number(const std::map<std::string, std::string>& row, const std::string& key) {
+  const auto found = row.find(key);
+  if (found == row.end() || found->second.empty()) return std::nan("");
+  try {
+    return std::stod(found->second);
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
+RunPoints ReadRunPoints(const std::filesystem::path& run_folder) {
+  RunPoints points;
+  for (const auto& row : ReadCsv(run_folder / "points.csv")) {
+    const double frame = Number(row, "frame"), id = Number(row, "point_id");
+    const double u = Number(row, "u"), v = Number(row, "v"), z = Number(row, "z_est");
+    if (!std::isfinite(frame) || !std::isfinite(id) || !std::isfinite(u) || !std::isfinite(v)) {
+      throw Error((run_folder / "points.csv").string() + ": a row without frame, point_id, u or v");
+    }
+    points[static_cast<int>(frame)][static_cast<int64_t>(id)] = {cv::Point2d(u, v), z};
+  }
+  return points;
+}
+
+CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const std::filesystem::path& b) {
+  const Json config = ReadJsonFile(a / "config.json");
+  const std::string sequence = config.at("sequence").get<std::string>();
+  const std::string other = ReadJsonFile(b / "config.json").at("sequence").get<std::string>();
+  if (other != sequence) throw Error("the runs are of different sequences: " + sequence + " and " + other);
+  const SequenceReader reader(sequence);
+  if (!reader.has_depth()) throw Error("sequence " + sequence + " has no depth to compare against");
+  // Scored as run a scored itself.
+  const auto options = OptionsFromJson<SystemOptions>(config.at("options"), (a / "config.json").string());
+  return CompareOnCommonPoints(ReadRunPoints(a), ReadRunPoints(b), [&](int frame) { return reader.ReadDepthMm(frame); },
+                               options.evaluation);
+}
+
+}  // namespace nrslam

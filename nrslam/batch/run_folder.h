@@ -1,0 +1,26 @@
+// batch: reading back what nrslam_run wrote in a run folder (system/run_sequence.h lists the
+// files), and comparing two run folders of one sequence on the points both report.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "nrslam/eval/common_points.h"
+
+namespace nrslam {
+
+// Rows of one of the runner's CSV files by column name (no quoted commas but in `note`).
+std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file);
+// A row's field as a number; NaN when missing, empty or not a number.
+double Number(const std::map<std::string, std::string>& row, const std::string& key);
+
+// points.csv as pixels and estimated depths per frame.
+RunPoints ReadRunPoints(const std::filesystem::path& run_folder);
+
+// Both runs must be of the same sequence (their config.json says which) and it must have
+// depth. Throws Error otherwise.
+CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const std::filesystem::path& b);
+
+}  // namespace nrslam
