@@ -55,16 +55,16 @@ Trajectories TopView(const std::filesystem::path& estimate_file, const std::vect
 }
 
 // The frame with each evaluated point drawn in its depth error, green (0) to red (≥ `full_mm`).
-cv::Mat DepthErrorImage(const SequenceReader& sequence, int frame, double scale,
-                        const std::vector<std::array<double, 3>>& points, double full_mm) {
+cv::Mat DepthErrorImage(const SequenceReader& sequence, int frame, double scale, const FramePoints& points,
+                        double full_mm) {
   cv::Mat image = sequence.ReadRgb(frame) * 0.6;
   const cv::Mat depth = sequence.ReadDepthMm(frame);
-  for (const auto& [u, v, z] : points) {
-    const auto truth = SampleDepth(depth, cv::Point2d(u, v));
+  for (const auto& [id, point] : points) {
+    const auto truth = SampleDepth(depth, point.pixel);
     if (!truth) continue;
-    const double error = std::min(1.0, std::abs(scale * z - *truth) / full_mm);
+    const double error = std::min(1.0, std::abs(scale * point.depth - *truth) / full_mm);
     const cv::Scalar colour(0, 255 * (1.0 - error), 255 * error);  // BGR
-    cv::circle(image, cv::Point(cvRound(u), cvRound(v)), 3, colour, cv::FILLED, cv::LINE_AA);
+    cv::circle(image, cv::Point(cvRound(point.pixel.x), cvRound(point.pixel.y)), 3, colour, cv::FILLED, cv::LINE_AA);
   }
   return image;
 }
@@ -107,11 +107,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
     if (sequence.has_depth() && tracked.size() > 1) {
       // The first frame after initialisation, the middle one and the last tracked one.
       const std::set<int> shown = {tracked[1], tracked[tracked.size() / 2], tracked.back()};
-      std::map<int, std::vector<std::array<double, 3>>> points;
-      for (const auto& row : ReadCsv(run / "points.csv")) {
-        const int frame = static_cast<int>(Number(row, "frame"));
-        if (shown.count(frame)) points[frame].push_back({Number(row, "u"), Number(row, "v"), Number(row, "z_est")});
-      }
+      RunPoints points = ReadRunPoints(run);
       const double full_mm = std::max(1.0, 3.0 * result.rmse_mm);
       html << "<p>Depth error of each tracked point, green = 0 to red ≥ " << FormatFixed(full_mm, 1)
            << " mm:</p><div class=\"images\">";
