@@ -7,6 +7,8 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -18,10 +20,12 @@
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-  const int frames = argc > 1 ? std::stoi(argv[1]) : 120;
-  std::vector<std::string> presets;
-  for (int i = 2; i < argc; ++i) presets.push_back(argv[i]);
-  if (presets.empty()) presets = {"sim-0", "sim-3", "sim-6"};
+  CLI::App app{"Whole-system speed and memory of monocular NR-SLAM on simulated sequences at 640x480"};
+  int frames = 120;
+  std::vector<std::string> presets = {"sim-0", "sim-3", "sim-6"};
+  app.add_option("frames", frames, "frames per sequence")->check(CLI::Range(2, 100000));
+  app.add_option("presets", presets, "simulator presets")->check(CLI::IsMember(nrslam::SimPresetNames()));
+  CLI11_PARSE(app, argc, argv);
   const fs::path work = fs::temp_directory_path() / ("nrslam_bench_system_" + std::to_string(::getpid()));
   std::printf("%-8s %-10s %6s %7s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
               "DBA ms", "triang ms", "RMSE mm", "points");

@@ -1,6 +1,9 @@
 // Tracking speed at 640x480: frames per second of tracking alone (rendering excluded) and
 // milliseconds per stage on a few presets: deformable (sparse Cholesky, the default), deformable
 // with the CGNR joint solver, and rigid. Target: >= 30 fps.
+//   bench_tracking [FRAMES=60]
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -9,7 +12,10 @@
 #include "nrslam/tracking/tracker.h"
 
 int main(int argc, char** argv) {
-  const int frames = argc > 1 ? std::stoi(argv[1]) : 60;
+  CLI::App app{"Tracking speed at 640x480 from a depth-initialised map (sim-0, sim-3, sim-6)"};
+  int frames = 60;
+  app.add_option("frames", frames, "frames per preset, the first one initialising")->check(CLI::Range(2, 100000));
+  CLI11_PARSE(app, argc, argv);
   std::printf("%-8s %-10s %7s %8s %8s %8s %8s %8s\n", "preset", "mode", "fps", "klt ms", "pose ms", "deform ms",
               "total ms", "points");
   for (const std::string preset : {"sim-0", "sim-3", "sim-6"}) {
