@@ -111,7 +111,8 @@ TEST(DeformableBundleAdjustment, RestoresEachKeyframesShapeAndKeepsTheOldestPose
   // lengths — with every observation reprojected, not the poses themselves.
   DbaScene scene;
   const double strain_before = scene.MeanStrain();
-  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, scene.graph, 1.0, 30, false, scene.Window());
+  const DbaReport report = DeformableBundleAdjustment(
+      scene.camera, scene.options, WindowRegularisers(scene.graph, scene.Window()), 1.0, 30, false, scene.Window());
   EXPECT_EQ(report.keyframes, 4);
   EXPECT_EQ(report.points, 60);
   EXPECT_LT(report.final_cost, 0.01 * report.initial_cost);
@@ -127,7 +128,7 @@ TEST(DeformableBundleAdjustment, RestoresEachKeyframesShapeAndKeepsTheOldestPose
 
 TEST(DeformableBundleAdjustment, RigidModeSharesOnePositionPerPoint) {
   DbaScene scene;
-  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, scene.graph, 1.0, 30, true, scene.Window());
+  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, {}, 1.0, 30, true, scene.Window());
   EXPECT_LT(report.final_cost, 0.01 * report.initial_cost);
   EXPECT_LT(scene.MaxReprojectionPx(), 0.5);
   for (int i = 0; i < 60; ++i) {
@@ -141,7 +142,7 @@ TEST(DeformableBundleAdjustment, RigidModeLeavesOutObservationsBehindTheCamera) 
   // evaluation and with it the whole solve (the model-selection trial on sim-6 did).
   DbaScene scene;
   scene.keyframes.back().positions[0] = Eigen::Vector3d(0, 0, -1);
-  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, scene.graph, 1.0, 30, true, scene.Window());
+  const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, {}, 1.0, 30, true, scene.Window());
   EXPECT_EQ(report.points, 59);
   EXPECT_LT(report.final_cost, 0.01 * report.initial_cost);
   for (const Keyframe& keyframe : scene.keyframes) {

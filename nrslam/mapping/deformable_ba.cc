@@ -14,8 +14,42 @@
 
 namespace nrslam {
 
+DbaRegularisers WindowRegularisers(const DeformationGraph& graph, const std::vector<Keyframe*>& window) {
+  // Point id → index per keyframe. Pairs come out in the iteration order of these maps, which
+  // fixes the order of the adjustment's residual blocks and so its floating-point sums.
+  std::vector<std::unordered_map<PointId, size_t>> index(window.size());
+  for (size_t k = 0; k < window.size(); ++k) {
+    for (size_t i = 0; i < window[k]->ids.size(); ++i) index[k][window[k]->ids[i]] = i;
+  }
+  DbaRegularisers regularisers(window.size());
+  for (size_t k = 0; k < window.size(); ++k) {
+    const auto seen = [&](PointId id) { return index[k].count(id) > 0; };
+    const auto index_next = [&](PointId id) {
+      if (k + 1 >= window.size()) return -1;
+      const auto found = index[k + 1].find(id);
+      return found == index[k + 1].end() ? -1 : static_cast<int>(found->second);
+    };
+    std::set<std::pair<PointId, PointId>> done;
+    for (const auto& [id, i] : index[k]) {
+      for (const GraphNeighbour& neighbour : graph.BestNeighbours(id, seen)) {
+        if (!done.insert(std::minmax(id, neighbour.id)).second) continue;
+        DbaPair pair;
+        pair.i = i;
+        pair.j = index[k].at(neighbour.id);
+        pair.rest_length = graph.edge(neighbour.edge).rest_length;
+        pair.weight_b = neighbour.weight;
+        pair.next_i = index_next(id);
+        pair.next_j = index_next(neighbour.id);
+        if (pair.next_i < 0 || pair.next_j < 0) pair.next_i = pair.next_j = -1;
+        regularisers[k].push_back(pair);
+      }
+    }
+  }
+  return regularisers;
+}
+
 DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationModelOptions& options,
-                                     const DeformationGraph& graph, double map_scale, int iterations, bool rigid,
+                                     const DbaRegularisers& regularisers, double map_scale, int iterations, bool rigid,
                                      const std::vector<Keyframe*>& window) {
   DbaReport report;
   report.keyframes = static_cast<int>(window.size());
@@ -27,9 +61,8 @@ DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationMode
 
   std::vector<PoseParams> poses;
   for (const Keyframe* keyframe : window) poses.push_back(keyframe->cam_from_world.ToParams());
-  // Per keyframe: point id → its position block. In rigid mode every keyframe shares one
-  // block per point (kept in `shared`, seeded from the newest keyframe that sees it).
-  std::vector<std::unordered_map<PointId, double*>> blocks(window.size());
+  // A position block per (keyframe, point), but in rigid mode every keyframe shares one block
+  // per point (kept in `shared`, seeded from the newest keyframe that sees it).
   std::unordered_map<PointId, Eigen::Vector3d> shared;
   if (rigid) {
     for (const Keyframe* keyframe : window) {
@@ -46,7 +79,6 @@ DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationMode
       // the tissue moved in between; its residual would fail Ceres's first evaluation and
       // with it the whole solve, so that observation sits the adjustment out.
       if (rigid && !camera.Project(keyframe.cam_from_world * Eigen::Map<const Eigen::Vector3d>(block))) continue;
-      blocks[k][keyframe.ids[i]] = block;
       points.insert(keyframe.ids[i]);
       problem.AddResidualBlock(CreateReprojectionCost(camera, keyframe.pixels[i], options.reprojection_sigma_px),
                                new ceres::HuberLoss(options.huber_reprojection), poses[k].data(), block);
@@ -58,23 +90,19 @@ DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationMode
 
   if (!rigid) {
     for (size_t k = 0; k < window.size(); ++k) {
-      const auto seen = [&](PointId id) { return blocks[k].count(id) > 0; };
-      const auto seen_next = [&](PointId id) { return seen(id) && k + 1 < window.size() && blocks[k + 1].count(id) > 0; };
-      std::set<std::pair<PointId, PointId>> done;
-      for (const auto& [id, block] : blocks[k]) {
-        for (const GraphNeighbour& neighbour : graph.BestNeighbours(id, seen)) {
-          if (!done.insert(std::minmax(id, neighbour.id)).second) continue;
-          const GraphEdge& edge = graph.edge(neighbour.edge);
-          problem.AddResidualBlock(ElasticCost::Create(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), edge.rest_length,
-                                                       ElasticMultiplier(options, edge.rest_length)),
-                                   nullptr, block, blocks[k].at(neighbour.id));
+      std::vector<Eigen::Vector3d>& positions = window[k]->positions;
+      for (const DbaPair& pair : regularisers[k]) {
+        problem.AddResidualBlock(ElasticCost::Create(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), pair.rest_length,
+                                                     ElasticMultiplier(options, pair.rest_length)),
+                                 nullptr, positions[pair.i].data(), positions[pair.j].data());
+        ++report.residual_blocks;
+        if (pair.next_i >= 0) {
+          std::vector<Eigen::Vector3d>& next = window[k + 1]->positions;
+          problem.AddResidualBlock(ViscousKeyframeCost::Create(ViscousMultiplier(options, pair.weight_b, map_scale)),
+                                   new ceres::HuberLoss(options.huber_deformation), positions[pair.i].data(),
+                                   next[static_cast<size_t>(pair.next_i)].data(), positions[pair.j].data(),
+                                   next[static_cast<size_t>(pair.next_j)].data());
           ++report.residual_blocks;
-          if (seen_next(id) && seen_next(neighbour.id)) {
-            problem.AddResidualBlock(ViscousKeyframeCost::Create(ViscousMultiplier(options, neighbour.weight, map_scale)),
-                                     new ceres::HuberLoss(options.huber_deformation), block,
-                                     blocks[k + 1].at(id), blocks[k].at(neighbour.id), blocks[k + 1].at(neighbour.id));
-            ++report.residual_blocks;
-          }
         }
       }
     }

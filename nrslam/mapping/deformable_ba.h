@@ -45,9 +45,25 @@ struct DbaReport {
   double baseline_ratio = -1, rigid_inlier_fraction = -1;
 };
 
-// Refines `window` (oldest first) in place; `graph` gives the edges and weights.
+// A regularised pair of one window keyframe: a point and one of its best D graph
+// neighbours, both seen by that keyframe (indices into its ids), with the edge's rest length
+// and weight b. next_i, next_j index the same two points in the next keyframe when both are
+// seen there too (they then also get a viscous term), else −1.
+struct DbaPair {
+  size_t i = 0, j = 0;
+  double rest_length = 0, weight_b = 0;
+  int next_i = -1, next_j = -1;
+};
+using DbaRegularisers = std::vector<std::vector<DbaPair>>;  // per window keyframe
+
+// Reads the graph once for a window, so that the adjustment itself needs no access to the
+// live map and can run beside tracking (MappingOptions::dba_lag_frames).
+DbaRegularisers WindowRegularisers(const DeformationGraph& graph, const std::vector<Keyframe*>& window);
+
+// Refines `window` (oldest first) in place. `regularisers` (from WindowRegularisers on the
+// same window) are used unless `rigid`.
 DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationModelOptions& options,
-                                     const DeformationGraph& graph, double map_scale, int iterations, bool rigid,
+                                     const DbaRegularisers& regularisers, double map_scale, int iterations, bool rigid,
                                      const std::vector<Keyframe*>& window);
 
 }  // namespace nrslam

@@ -51,6 +51,7 @@ void Mapper::Record(const FrameResult& result, const Tracker& tracker) {
 }
 
 void Mapper::StartMap(const FrameResult& start, const Tracker& tracker, const std::optional<Keyframe>& reference) {
+  pending_dba_.reset();  // an adjustment of the old map (waits for it to end)
   buffer_.clear();
   keyframes_.clear();
   if (reference) keyframes_.push_back(*reference);
@@ -64,11 +65,16 @@ void Mapper::StartMap(const FrameResult& start, const Tracker& tracker, const st
 MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker) {
   MappingReport report;
   Record(result, *tracker);
+  if (pending_dba_ && (result.frame >= pending_dba_->apply_frame || result.keyframe)) {
+    FinishDba(result.frame, tracker, &report);
+  }
   if (result.keyframe) {
     keyframes_.push_back(MakeKeyframe(result, *tracker));
     ++map_keyframes_;
     while (static_cast<int>(keyframes_.size()) > options_.dba_window) keyframes_.pop_front();
-    if (options_.dba && static_cast<int>(keyframes_.size()) >= options_.dba_min_keyframes) RunDba(tracker, &report);
+    if (options_.dba && static_cast<int>(keyframes_.size()) >= options_.dba_min_keyframes) {
+      StartDba(result.frame, tracker, &report);
+    }
   } else {
     Triangulate(result, bgr, tracker, &report);
   }
@@ -106,48 +112,96 @@ double Mapper::BaselineRatio(const std::deque<Keyframe>& keyframes) const {
   return travel / Median(depths);
 }
 
-void Mapper::RunDba(Tracker* tracker, MappingReport* report) {
+void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
   const auto start = Clock::now();
-  Map& map = tracker->mutable_map();
+  const Map& map = tracker->map();
   const bool warmup = two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
-  bool rigid_shape = rigid_ || warmup;
+  const bool rigid_shape = rigid_ || warmup;
+  const DbaRegularisers regularisers =
+      rigid_shape ? DbaRegularisers{} : WindowRegularisers(map.graph(), Pointers(&keyframes_));
+  PendingDba pending;
+  pending.keyframe_frame = frame;
+  pending.apply_frame = frame + options_.dba_lag_frames;
+  pending.newest_before = keyframes_.back();
+  const auto adjust = [this, keyframes = keyframes_, regularisers, scale = map.scale(), rigid_shape]() {
+    return AdjustWindow(keyframes, regularisers, scale, rigid_shape);
+  };
+  // Deferred: run by FinishDba on this thread.
+  pending.adjusted = std::async(options_.dba_lag_frames > 0 ? std::launch::async : std::launch::deferred, adjust);
+  pending_dba_ = std::move(pending);
+  report->ms_dba += MillisecondsSince(start);
+  if (options_.dba_lag_frames == 0) FinishDba(frame, tracker, report);
+}
+
+Mapper::AdjustedWindow Mapper::AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers,
+                                            double map_scale, bool rigid_shape) const {
+  AdjustedWindow result;
   bool adjusted = false;
   double baseline_ratio = -1, rigid_inlier_fraction = -1;  // not measured
   if (!rigid_shape && options_.dba_model_selection) {
     // The tracked camera travel, before any adjustment: a short baseline leaves a rigid fit
     // free to turn deformation into depth error, however well it reprojects.
-    baseline_ratio = BaselineRatio(keyframes_);
+    baseline_ratio = BaselineRatio(keyframes);
     if (baseline_ratio >= options_.rigid_dba_min_baseline) {
-      std::deque<Keyframe> trial = keyframes_;
-      const DbaReport rigid_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
+      std::deque<Keyframe> trial = keyframes;
+      const DbaReport rigid_report = DeformableBundleAdjustment(camera_, deformation_, {}, map_scale,
                                                                 options_.dba_iterations, true, Pointers(&trial));
       rigid_inlier_fraction = InlierFraction(trial);
       if (rigid_inlier_fraction >= options_.rigid_dba_min_inliers) {
-        keyframes_ = std::move(trial);
-        report->dba_report = rigid_report;
+        keyframes = std::move(trial);
+        result.report = rigid_report;
         rigid_shape = adjusted = true;
       }
     }
   }
   if (!adjusted) {
-    report->dba_report = DeformableBundleAdjustment(camera_, deformation_, map.graph(), map.scale(),
-                                                    options_.dba_iterations, rigid_shape, Pointers(&keyframes_));
+    result.report = DeformableBundleAdjustment(camera_, deformation_, regularisers, map_scale, options_.dba_iterations,
+                                               rigid_shape, Pointers(&keyframes));
   }
-  report->dba_report.rigid = rigid_shape;
-  report->dba_report.baseline_ratio = baseline_ratio;
-  report->dba_report.rigid_inlier_fraction = rigid_inlier_fraction;
+  result.report.rigid = rigid_shape;
+  result.report.baseline_ratio = baseline_ratio;
+  result.report.rigid_inlier_fraction = rigid_inlier_fraction;
+  result.keyframes = std::move(keyframes);
+  return result;
+}
+
+void Mapper::FinishDba(int frame, Tracker* tracker, MappingReport* report) {
+  const auto start = Clock::now();
+  PendingDba pending = std::move(*pending_dba_);
+  pending_dba_.reset();
+  AdjustedWindow adjusted = pending.adjusted.get();
+  report->dba_report = adjusted.report;
   report->dba = true;
-  // The newest keyframe is this frame: its shape and pose are what tracking goes on from.
-  const Keyframe& newest = keyframes_.back();
-  Snapshot& snapshot = buffer_.back();
-  for (size_t i = 0; i < newest.ids.size(); ++i) {
-    map.point(newest.ids[i]).position = newest.positions[i];
-    snapshot.points.at(newest.ids[i]).second = newest.positions[i];
+  // The newest keyframe's shape and pose are what tracking goes on from. When frames were
+  // tracked since, their motion is kept on top: a point becomes its adjusted position plus
+  // how far tracking moved it after the keyframe, and the camera keeps its pose relative to
+  // the keyframe's (both exact no-ops when the result is applied on the keyframe itself).
+  const Keyframe& before = pending.newest_before;
+  const Keyframe& after = adjusted.keyframes.back();
+  std::unordered_map<PointId, size_t> index;
+  for (size_t i = 0; i < after.ids.size(); ++i) index.emplace(after.ids[i], i);
+  const auto corrected = [&](PointId id, const Eigen::Vector3d& position) {
+    const size_t i = index.at(id);
+    return Eigen::Vector3d(after.positions[i] + (position - before.positions[i]));
+  };
+  const auto corrected_pose = [&](const Rigid3& cam_from_world, int at_frame) {
+    return at_frame == pending.keyframe_frame ? after.cam_from_world
+                                              : cam_from_world * before.cam_from_world.Inverse() * after.cam_from_world;
+  };
+  Map& map = tracker->mutable_map();
+  for (const PointId id : after.ids) map.point(id).position = corrected(id, map.point(id).position);
+  for (Snapshot& snapshot : buffer_) {
+    if (snapshot.frame < pending.keyframe_frame) continue;
+    for (const PointId id : after.ids) {
+      const auto found = snapshot.points.find(id);
+      if (found != snapshot.points.end()) found->second.second = corrected(id, found->second.second);
+    }
+    snapshot.cam_from_world = corrected_pose(snapshot.cam_from_world, snapshot.frame);
   }
-  if (rigid_shape && !rigid_) map.graph().ResetRestShape(newest.ids, map.Positions());
-  snapshot.cam_from_world = newest.cam_from_world;
-  tracker->SetPose(newest.cam_from_world);
-  report->ms_dba = MillisecondsSince(start);
+  if (adjusted.report.rigid && !rigid_) map.graph().ResetRestShape(after.ids, map.Positions());
+  tracker->SetPose(corrected_pose(tracker->pose(), frame));
+  keyframes_ = std::move(adjusted.keyframes);
+  report->ms_dba += MillisecondsSince(start);
 }
 
 Eigen::Vector3d Mapper::WorldRay(const CandidateTrack& track, size_t i) const {

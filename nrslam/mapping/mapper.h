@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include <deque>
+#include <future>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -71,9 +72,31 @@ class Mapper {
   bool two_view_map_ = false;  // the map came from monocular initialisation (not from depth)
   int start_points_ = 0;       // 3D points the map started with
 
+  // A DBA in flight: the window it adjusts (its own copy) and what the newest keyframe was
+  // before, so that tracking's motion since then can be kept when the result is applied.
+  struct AdjustedWindow {
+    std::deque<Keyframe> keyframes;
+    DbaReport report;
+  };
+  struct PendingDba {
+    int keyframe_frame = 0, apply_frame = 0;
+    Keyframe newest_before;
+    std::future<AdjustedWindow> adjusted;
+  };
+  std::optional<PendingDba> pending_dba_;
+
   void Record(const FrameResult& result, const Tracker& tracker);
   Keyframe MakeKeyframe(const FrameResult& result, const Tracker& tracker) const;
-  void RunDba(Tracker* tracker, MappingReport* report);
+  // Starts the DBA of the window that ends on this keyframe (on another thread when
+  // dba_lag_frames > 0), and applies it at once when the lag is 0.
+  void StartDba(int frame, Tracker* tracker, MappingReport* report);
+  // Waits for the pending DBA and applies it: keyframe poses and shapes, the map, the buffer
+  // and the tracker's pose.
+  void FinishDba(int frame, Tracker* tracker, MappingReport* report);
+  // The DBA proper (rigid trial, model selection, deformable adjustment); reads only its
+  // arguments and constant members, so it can run beside tracking.
+  AdjustedWindow AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers, double map_scale,
+                              bool rigid_shape) const;
   // Of every (keyframe, point) observation, the fraction reprojecting within max_reprojection_px2.
   double InlierFraction(const std::deque<Keyframe>& keyframes) const;
   // Camera travel from the oldest to the newest keyframe over the newest one's median depth.

@@ -20,6 +20,7 @@ void InitialisationOptions::Check() const {
 void MappingOptions::Check() const {
   CheckOption(dba_window >= 2 && dba_min_keyframes >= 2 && dba_min_keyframes <= dba_window && dba_iterations >= 1,
               "mapping", "need 2 <= dba_min_keyframes <= dba_window and dba_iterations >= 1");
+  CheckOption(dba_lag_frames >= 0, "mapping", "dba_lag_frames must be >= 0");
   CheckOption(temporal_window >= 2 && neighbours >= 1 && deformable_min_track >= 2 && deformable_iterations >= 1,
               "mapping", "temporal_window, neighbours, deformable_min_track and iterations out of range");
   CheckOption(crowding_radius_px >= 0 && neighbour_radius_px > crowding_radius_px, "mapping",

@@ -42,6 +42,11 @@ struct MappingOptions {
   int dba_window = 5;                // keyframes in the window (paper's N_k)
   int dba_min_keyframes = 3;         // fewer: no DBA
   int dba_iterations = 5;            // LM iterations
+  // Frames the DBA of a keyframe may run beside tracking before its result is applied (on
+  // the keyframe + this many frames, or on the next keyframe if sooner). 0: at once, on the
+  // keyframe, as the reference. The result is always applied on that same frame, whatever
+  // the timing, so runs stay repeatable; tracking's motion since the keyframe is kept.
+  int dba_lag_frames = 0;
   // The first keyframes of a two-view map are adjusted rigidly and their shape becomes the
   // DDG's rest shape: the map's depths get corrected by the growing baseline before the
   // per-keyframe shapes can absorb their error (counting the initial two). A map from depth
@@ -96,6 +101,7 @@ struct MappingOptions {
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
+                                                dba_lag_frames,
                                                 rigid_warmup_keyframes, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
