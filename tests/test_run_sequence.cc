@@ -5,6 +5,7 @@
 #include <omp.h>
 #include <opencv2/videoio.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -17,7 +18,9 @@
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/deformation/deformation_graph.h"
 #include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
+#include "nrslam/io/tum.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/util/error.h"
@@ -124,6 +127,30 @@ TEST_F(RunSequenceTest, SummaryRmseIsRecomputableFromPointsCsvAndGroundTruth) {
   EXPECT_NEAR(recomputed.rmse_median_mm, summary.at("rmse_median_mm").get<double>(), 1e-5);
   EXPECT_NEAR(recomputed.rmse_pooled_mm, summary.at("rmse_pooled_mm").get<double>(), 1e-5);
   EXPECT_EQ(summary.at("frames_tracked").get<int>(), 40);
+}
+
+TEST_F(RunSequenceTest, TrajectoryErrorIsRecomputableFromTheTumFilesAndSmall) {
+  const SequenceReader reader(*base_ / "sequence");
+  TrajectorySegment map;
+  double travel = 0;
+  for (const StampedPose& pose : ReadTum(*base_ / "run" / "trajectory.tum")) {
+    const auto frame = static_cast<size_t>(std::lround(pose.timestamp * reader.info().fps));
+    map.estimated.push_back(pose.world_from_camera.translation);
+    map.groundtruth.push_back(reader.groundtruth().at(frame).world_from_camera.translation);
+    if (map.groundtruth.size() > 1) travel += (map.groundtruth.back() - map.groundtruth[map.groundtruth.size() - 2]).norm();
+  }
+  const TrajectoryError recomputed = AlignedTrajectoryError({map});
+  nlohmann::json summary;
+  std::ifstream(*base_ / "run" / "summary.json") >> summary;
+  ASSERT_TRUE(recomputed.evaluated);
+  EXPECT_NEAR(recomputed.rmse_mm, summary.at("ate_rmse_mm").get<double>(), 1e-5);
+  EXPECT_NEAR(recomputed.scale, summary.at("ate_scale").get<double>(), 1e-5);
+  EXPECT_EQ(summary.at("ate_frames").get<int>(), 40);
+  std::cout << "trajectory error " << recomputed.rmse_mm << " mm over " << travel << " mm of travel, scale "
+            << recomputed.scale << "\n";
+  EXPECT_LT(recomputed.rmse_mm, 0.05 * travel);
+  // Initialised from depth in mm: the map is already in mm.
+  EXPECT_NEAR(recomputed.scale, 1.0, 0.1);
 }
 
 // A run folder's config.json repeats the run: the same options, and the same trajectory.

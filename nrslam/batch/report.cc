@@ -80,7 +80,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   }
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
-       << "), run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
+       << "), trajectory error " << AteCell(result) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
     const Json config = ReadJsonFile(run / "config.json");
@@ -176,17 +176,18 @@ void WriteReport(const std::vector<RunResult>& results, const std::filesystem::p
           "{text-align:left}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
           "figure{margin:0}section{margin-top:28px}</style></head><body>\n<h1>nrslam evaluation</h1>\n";
   html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
-          "<th>fps</th></tr>\n";
+          "<th>ATE mm</th><th>fps</th></tr>\n";
   for (const RunResult& r : results) {
     const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
     html << "<tr><td><a href=\"#" << EscapeXml(Slug(r)) << "\">" << EscapeXml(key) << "</a></td>";
     if (r.status == "failed") {
-      html << "<td class=\"failed\">FAILED</td><td colspan=\"5\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
+      html << "<td class=\"failed\">FAILED</td><td colspan=\"6\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
       continue;
     }
     html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
-         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FormatFixed(r.fps, 1) << "</td></tr>\n";
+         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << AteCell(r) << "</td><td>" << FormatFixed(r.fps, 1)
+         << "</td></tr>\n";
   }
   html << "</table>\n" << SweepSection(results);
   for (const RunResult& r : results) html << RunSection(r, folder);

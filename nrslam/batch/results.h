@@ -21,12 +21,15 @@ struct RunResult {
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
+  double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
   std::string run_folder;
   bool evaluated() const { return frames_evaluated > 0; }
 };
 
 // An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
 std::string RmseCell(const RunResult& result, double rmse_mm);
+// The trajectory error as a table shows it: "-" when there was none.
+std::string AteCell(const RunResult& result);
 
 // Reads each run's summary.json (or failure.json) from its folder.
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan);
@@ -40,7 +43,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder);
 
 // The table a person reads: sequence, [sweep point], status, init frame, tracked/total,
-// RMSE mean and median (mm), fps. With sweeps, also the mean RMSE per value of each option
+// RMSE mean and median (mm), trajectory error (mm), fps. With sweeps, also the mean RMSE per value of each option
 // over the sequences tracked at every point.
 void PrintResults(const std::vector<RunResult>& results, std::ostream& out);
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
@@ -168,6 +169,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   };
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
+  std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
   FrameIo io(reader, first, last);
   for (int frame = first; frame < last; ++frame) {
@@ -235,6 +237,12 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     if (tracked) {
       ++summary.frames_tracked;
       trajectory.push_back({frame / reader.info().fps, result.cam_from_world.Inverse()});
+      if (reader.has_groundtruth()) {
+        aligned_maps.resize(static_cast<size_t>(maps));
+        aligned_maps.back().estimated.push_back(trajectory.back().world_from_camera.translation);
+        aligned_maps.back().groundtruth.push_back(
+            reader.groundtruth()[static_cast<size_t>(frame)].world_from_camera.translation);
+      }
       for (const TrackedPoint& point : result.points) {
         const Eigen::Vector3d world = tracker.map().point(point.id).position;
         const double z = (result.cam_from_world * world).z();
@@ -287,6 +295,11 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.rmse_median_mm = metrics.rmse_median_mm;
   summary.rmse_pooled_mm = metrics.rmse_pooled_mm;
   summary.frames_evaluated = metrics.frames_evaluated;
+  const TrajectoryError trajectory_error = AlignedTrajectoryError(aligned_maps);
+  if (trajectory_error.evaluated) {
+    summary.ate_mm = trajectory_error.rmse_mm;
+    summary.ate_scale = trajectory_error.scale;
+  }
 
   WriteTum(out / "trajectory.tum", trajectory);
   WritePly(out / "map.ply", tracker.map());
@@ -305,6 +318,10 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                                                    {"dba", summary.ms_dba},
                                                    {"triangulation", summary.ms_triangulation}}},
                                  {"maps", summary.maps},
+                                 // null without ground-truth poses or a moving camera
+                                 {"ate_rmse_mm", trajectory_error.evaluated ? nlohmann::json(trajectory_error.rmse_mm) : nlohmann::json()},
+                                 {"ate_scale", trajectory_error.evaluated ? nlohmann::json(trajectory_error.scale) : nlohmann::json()},
+                                 {"ate_frames", trajectory_error.poses},
                                  {"map_points", summary.map_points},
                                  {"init", options.run.init},
                                  {"mapping", options.run.mapping},
