@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     } else {
       std::cout << "no ground truth, no RMSE  ";
     }
-    if (summary.ate_mm >= 0) std::cout << "trajectory error " << summary.ate_mm << " mm  ";
+    if (summary.trajectory_error.evaluated) std::cout << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
     std::cout << summary.fps << " fps\nrun folder: " << out << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_run: " << e.what() << '\n';

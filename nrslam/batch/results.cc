@@ -107,8 +107,9 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
          "ate_rmse_mm,fps,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
-        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
-        << (r.ate_mm >= 0 ? std::to_string(r.ate_mm) : std::string()) << ',' << r.fps
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',';
+    if (r.ate_mm >= 0) csv << r.ate_mm;  // empty without a trajectory error
+    csv << ',' << r.fps
         << ',' << CsvField(r.error) << '\n';
   }
 }

@@ -117,17 +117,17 @@ void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
   const Map& map = tracker->map();
   const bool warmup = two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
   const bool rigid_shape = rigid_ || warmup;
-  const DbaRegularisers regularisers =
-      rigid_shape ? DbaRegularisers{} : WindowRegularisers(map.graph(), Pointers(&keyframes_));
+  DbaRegularisers regularisers = rigid_shape ? DbaRegularisers{} : WindowRegularisers(map.graph(), Pointers(&keyframes_));
   PendingDba pending;
   pending.keyframe_frame = frame;
   pending.apply_frame = frame + options_.dba_lag_frames;
   pending.newest_before = keyframes_.back();
-  const auto adjust = [this, keyframes = keyframes_, regularisers, scale = map.scale(), rigid_shape]() {
-    return AdjustWindow(keyframes, regularisers, scale, rigid_shape);
-  };
+  // The job owns its copy of the window, which it adjusts and hands back.
+  auto adjust = [this, keyframes = keyframes_, regularisers = std::move(regularisers), scale = map.scale(),
+                 rigid_shape]() mutable { return AdjustWindow(std::move(keyframes), regularisers, scale, rigid_shape); };
   // Deferred: run by FinishDba on this thread.
-  pending.adjusted = std::async(options_.dba_lag_frames > 0 ? std::launch::async : std::launch::deferred, adjust);
+  pending.adjusted =
+      std::async(options_.dba_lag_frames > 0 ? std::launch::async : std::launch::deferred, std::move(adjust));
   pending_dba_ = std::move(pending);
   report->ms_dba += MillisecondsSince(start);
   if (options_.dba_lag_frames == 0) FinishDba(frame, tracker, report);

@@ -9,7 +9,6 @@
 #include <sstream>
 
 #include "nrslam/eval/depth_evaluation.h"
-#include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
@@ -295,11 +294,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.rmse_median_mm = metrics.rmse_median_mm;
   summary.rmse_pooled_mm = metrics.rmse_pooled_mm;
   summary.frames_evaluated = metrics.frames_evaluated;
-  const TrajectoryError trajectory_error = AlignedTrajectoryError(aligned_maps);
-  if (trajectory_error.evaluated) {
-    summary.ate_mm = trajectory_error.rmse_mm;
-    summary.ate_scale = trajectory_error.scale;
-  }
+  summary.trajectory_error = AlignedTrajectoryError(aligned_maps);
+  const TrajectoryError& trajectory_error = summary.trajectory_error;
 
   WriteTum(out / "trajectory.tum", trajectory);
   WritePly(out / "map.ply", tracker.map());

@@ -15,6 +15,7 @@
 #include <functional>
 #include <string>
 
+#include "nrslam/eval/trajectory_error.h"
 #include "nrslam/system/system_options.h"
 
 namespace nrslam {
@@ -29,9 +30,7 @@ struct RunSummary {
   double fps = 0;          // frames processed per second of wall time (reading included)
   // Mean milliseconds per processed frame in each stage (the mapping stages run on some frames only).
   double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
-  // Camera trajectory error after aligning each map to the ground truth by a similarity
-  // (eval/trajectory_error.h); negative when there was none to align.
-  double ate_mm = -1, ate_scale = 0;
+  TrajectoryError trajectory_error;  // camera centres aligned to the ground-truth poses per map
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
 };
