@@ -50,6 +50,12 @@ TEST(JsonOptions, TrackingLinearSolverIsAChoiceOfTwo) {
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"joint_linear_solver=qr"}), Error);
 }
 
+TEST(JsonOptions, DisplacementPriorIsOffByDefaultAndNeverNegative) {
+  EXPECT_EQ(TrackingOptions{}.displacement_prior_sigma, 0.0);
+  EXPECT_EQ(WithAssignments(TrackingOptions{}, {"displacement_prior_sigma=0.2"}).displacement_prior_sigma, 0.2);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"displacement_prior_sigma=-0.2"}), Error);
+}
+
 TEST(JsonOptions, DbaModelSelectionThresholdsAreValidatedAndRoundTrip) {
   const MappingOptions options = WithAssignments(
       MappingOptions{}, {"dba_model_selection=false", "rigid_dba_min_inliers=0.99", "rigid_dba_min_baseline=0.5"});

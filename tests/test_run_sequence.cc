@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 
@@ -33,7 +34,8 @@ namespace fs = std::filesystem;
 struct CsvPoint {
   int frame;
   PointId id;
-  double u, v, z, world_z;
+  double u, v, z;  // pixel and estimated depth (mm)
+  Eigen::Vector3d world;  // mm
 };
 
 std::vector<CsvPoint> ReadPointsCsv(const fs::path& path) {
@@ -45,8 +47,7 @@ std::vector<CsvPoint> ReadPointsCsv(const fs::path& path) {
     std::replace(line.begin(), line.end(), ',', ' ');
     std::istringstream fields(line);
     CsvPoint p;
-    double x, y;
-    fields >> p.frame >> p.id >> p.u >> p.v >> p.z >> x >> y >> p.world_z;
+    fields >> p.frame >> p.id >> p.u >> p.v >> p.z >> p.world.x() >> p.world.y() >> p.world.z();
     points.push_back(p);
   }
   return points;
@@ -187,6 +188,30 @@ TEST_F(RunSequenceTest, SavedConfigRepeatsTheRun) {
     return content.str();
   };
   EXPECT_EQ(text(*base_ / "repeated" / "trajectory.tum"), text(*base_ / "run" / "trajectory.tum"));
+}
+
+// How far each map point moved in the world between the first and the last frame it was reported in.
+std::vector<double> PointMovementsMm(const fs::path& points_csv) {
+  std::map<PointId, std::pair<Eigen::Vector3d, Eigen::Vector3d>> first_last;
+  for (const CsvPoint& p : ReadPointsCsv(points_csv)) {
+    const auto [it, added] = first_last.emplace(p.id, std::make_pair(p.world, p.world));
+    it->second.second = p.world;
+  }
+  std::vector<double> movements;
+  for (const auto& [id, ends] : first_last) movements.push_back((ends.second - ends.first).norm());
+  return movements;
+}
+
+TEST_F(RunSequenceTest, StiffDisplacementPriorHoldsThePointsWhereTheyWere) {
+  SystemOptions options = TrackingExperiment();
+  options.tracking.displacement_prior_sigma = 1e-6;  // map-scale units: δ can hardly leave 0
+  RunSequence(*base_ / "sequence", options, *base_ / "held");  // a frozen map may lose a deforming scene: fine
+  const std::vector<double> held = PointMovementsMm(*base_ / "held" / "points.csv");
+  const std::vector<double> free = PointMovementsMm(*base_ / "run" / "points.csv");
+  ASSERT_FALSE(held.empty());
+  EXPECT_LT(*std::max_element(held.begin(), held.end()), 1e-3);
+  // Without the prior the same points follow the tissue (A = 5 mm).
+  EXPECT_GT(std::accumulate(free.begin(), free.end(), 0.0) / free.size(), 0.5);
 }
 
 TEST(SystemOptionsNames, UniqueLastNamesResolveToFullPaths) {

@@ -1,6 +1,7 @@
 #include "nrslam/tracking/tracker.h"
 
 #include <ceres/loss_function.h>
+#include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 #include <opencv2/imgproc.hpp>
@@ -353,6 +354,11 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
                                                    ElasticMultiplier(deformation_, pair.rest_length)));
     viscous_costs.emplace_back(ViscousCost::Create(pair.viscous_multiplier));
   }
+  std::unique_ptr<ceres::CostFunction> displacement_prior;
+  if (options_.displacement_prior_sigma > 0) {
+    displacement_prior = std::make_unique<ceres::NormalPrior>(
+        Eigen::Matrix3d::Identity() / (options_.displacement_prior_sigma * map_->scale()), Eigen::Vector3d::Zero());
+  }
   ceres::HuberLoss reprojection_loss(deformation_.huber_reprojection), deformation_loss(deformation_.huber_deformation);
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -369,6 +375,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
     problem.AddParameterBlock(params.data(), kPoseParams, &manifold);
     for (size_t i = 0; i < n; ++i) {
       problem.AddParameterBlock((*displacements)[i].data(), 3);
+      if (displacement_prior) problem.AddResidualBlock(displacement_prior.get(), nullptr, (*displacements)[i].data());
       if ((*inliers)[i]) {
         problem.AddResidualBlock(reprojection_costs[i].get(), &reprojection_loss, params.data(),
                                  (*displacements)[i].data());

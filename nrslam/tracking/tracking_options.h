@@ -23,6 +23,10 @@ struct TrackingOptions {
   std::string joint_linear_solver = "sparse_cholesky";
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
   double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
+  // σ of a zero-mean prior on each point's displacement δ, in map-scale units (0: none, the
+  // reference). Moving the camera and every δ by the same amount changes no other residual,
+  // so without a prior nothing but LM damping decides how much of a common motion is the camera's.
+  double displacement_prior_sigma = 0.0;
   // Mid-term re-association: a lost map point is looked for again by a KLT seeded at its
   // projection, with the patch of the keyframe it was last tracked from.
   bool reassociation = true;
@@ -34,6 +38,7 @@ struct TrackingOptions {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
                                                 deformation_iterations, joint_linear_solver, outlier_chi2, displacement_iqr_factor,
+                                                displacement_prior_sigma,
                                                 reassociation, reassociation_levels, reassociation_gate_px2,
                                                 lost_max_age_frames)
 
