@@ -181,6 +181,47 @@ TEST(Results, RunsWithoutGroundTruthShowNoRmse) {
   EXPECT_EQ(ResultsFromJson(old)[0].frames_evaluated, 42);
 }
 
+// Known answers for a 2 × 2 grid (k, D) over three sequences, one of which is lost at k = 10:
+// only the two sequences complete at every point count, each value sees 2 points × 2 sequences.
+TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {
+  std::vector<RunResult> results;
+  for (const std::string sequence : {"a", "b", "c"}) {
+    for (const std::string k : {"10", "2"}) {  // "2" comes first: numeric order
+      for (const std::string d : {"3", "5"}) {
+        RunResult r;
+        r.sequence = sequence;
+        r.point = {"deformation.k=" + k, "deformation.max_degree_D=" + d};
+        r.label = "k=" + k + " D=" + d;
+        r.status = sequence == "c" && k == "10" ? "lost" : "ok";
+        r.frames_evaluated = 100;
+        r.rmse_mm = (sequence == "a" ? 1.0 : 2.0) * std::stod(k) + std::stod(d) / 10;  // c equals b
+        r.ate_mm = sequence == "b" && d == "5" ? -1 : r.rmse_mm / 2;
+        results.push_back(r);
+      }
+    }
+  }
+  const std::vector<SweepValueSummary> values = SummariseSweep(results);
+  ASSERT_EQ(values.size(), 4u);
+  EXPECT_EQ(values[0].option, "deformation.k");
+  EXPECT_EQ(values[0].value, "2");
+  EXPECT_EQ(values[1].value, "10");
+  EXPECT_EQ(values[2].option, "deformation.max_degree_D");
+  for (const SweepValueSummary& v : values) EXPECT_EQ(v.runs, 4) << v.option << "=" << v.value;
+  // k = 2 over a and b: 2.3 2.5 4.3 4.5.
+  EXPECT_DOUBLE_EQ(values[0].mean_rmse_mm, 3.4);
+  EXPECT_DOUBLE_EQ(values[0].median_rmse_mm, 4.3);  // the upper median
+  EXPECT_LT(values[0].mean_ate_mm, 0);              // b at D = 5 has none
+  EXPECT_EQ(values[0].short_runs, 0);
+  EXPECT_EQ(values[1].short_runs, 2);               // c at k = 10, both D
+  // D = 3 over a and b: 2.3 10.3 4.3 20.3; every one of them has a trajectory error.
+  EXPECT_DOUBLE_EQ(values[2].mean_rmse_mm, 9.3);
+  EXPECT_DOUBLE_EQ(values[2].mean_ate_mm, 4.65);
+  EXPECT_EQ(values[2].short_runs, 1);
+  std::stringstream table;
+  PrintResults(results, table);
+  EXPECT_NE(table.str().find("over the 2 sequence(s)"), std::string::npos) << table.str();
+}
+
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   const auto folder = UniqueTempFolder("batch_broken");
   // A sequence folder with an incomplete sequence.json, between two good simulated ones (eight

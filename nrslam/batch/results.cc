@@ -3,8 +3,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <numeric>
 #include <sstream>
 
+#include "nrslam/util/median.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -33,6 +35,16 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->fps = json.value("fps", 0.0);
   const auto ate = json.find("ate_rmse_mm");
   result->ate_mm = ate != json.end() && ate->is_number() ? ate->get<double>() : -1.0;
+}
+
+// Sequence -> whether every run of it (every sweep point) tracked to the end with ground truth.
+std::map<std::string, bool> CompleteSequences(const std::vector<RunResult>& results) {
+  std::map<std::string, bool> complete;
+  for (const RunResult& r : results) {
+    const bool ok = r.status == "ok" && r.evaluated();
+    complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
+  }
+  return complete;
 }
 
 }  // namespace
@@ -142,41 +154,61 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     if (r.status == "failed") out << "FAILED " << Key(r) << ": " << r.error << '\n';
   }
   if (!swept) return;
-  // Per swept option and value: mean RMSE over the sequences that tracked every frame at
-  // every point of the sweep, so each value is averaged over the same sequences.
-  std::map<std::string, bool> complete;  // sequence -> ok at every point
-  for (const RunResult& r : results) {
-    const bool ok = r.status == "ok" && r.evaluated();
-    complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
+  const std::vector<SweepValueSummary> values = SummariseSweep(results);
+  int sequences = 0;
+  for (const auto& [name, ok] : CompleteSequences(results)) sequences += ok;
+  out << "\nPer swept value, over the " << sequences << " sequence(s) tracked to the end at every point"
+      << " (not to end: that value's runs, over all sequences, lost or failed):\n";
+  TextTable summary({"option", "value", "mean RMSE mm", "median mm", "mean ATE mm", "runs", "not to end"});
+  for (const SweepValueSummary& v : values) {
+    const bool any = v.runs > 0;
+    summary.AddRow({v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-",
+                    any ? FormatFixed(v.median_rmse_mm, 3) : "-",
+                    any && v.mean_ate_mm >= 0 ? FormatFixed(v.mean_ate_mm, 3) : "-", std::to_string(v.runs),
+                    std::to_string(v.short_runs)});
   }
-  // Values in numeric order when they are numbers ("5" before "10"), else as text.
+  summary.Print(out);
+}
+
+std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results) {
+  const std::map<std::string, bool> complete = CompleteSequences(results);
   const auto value_order = [](const std::string& a, const std::string& b) {
     char *end_a = nullptr, *end_b = nullptr;
     const double x = std::strtod(a.c_str(), &end_a), y = std::strtod(b.c_str(), &end_b);
     return *end_a == '\0' && *end_b == '\0' && x != y ? x < y : a < b;
   };
-  using ValueCells = std::map<std::string, std::pair<double, int>, decltype(value_order)>;  // value -> (sum, n)
-  std::map<std::string, ValueCells> by_value;
+  struct Cell {
+    std::vector<double> rmse, ate;
+    bool ate_everywhere = true;
+    int short_runs = 0;
+  };
+  std::map<std::string, std::map<std::string, Cell, decltype(value_order)>> by_value;
   for (const RunResult& r : results) {
-    if (!complete[r.sequence]) continue;
     for (const std::string& assignment : r.point) {
       const size_t equals = assignment.find('=');
-      auto& cells = by_value.try_emplace(assignment.substr(0, equals), value_order).first->second;
-      auto& cell = cells[assignment.substr(equals + 1)];
-      cell.first += r.rmse_mm;
-      cell.second += 1;
+      Cell& cell = by_value.try_emplace(assignment.substr(0, equals), value_order).first->second[assignment.substr(equals + 1)];
+      if (r.status != "ok") ++cell.short_runs;
+      if (!complete.at(r.sequence)) continue;
+      cell.rmse.push_back(r.rmse_mm);
+      cell.ate.push_back(r.ate_mm);
+      cell.ate_everywhere &= r.ate_mm >= 0;
     }
   }
-  int sequences = 0;
-  for (const auto& [name, ok] : complete) sequences += ok;
-  out << "\nMean RMSE per swept value, over the " << sequences << " sequence(s) tracked to the end at every point:\n";
-  TextTable summary({"option", "value", "mean RMSE mm", "runs"});
+  const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
+  std::vector<SweepValueSummary> summaries;
   for (const auto& [option, values] : by_value) {
     for (const auto& [value, cell] : values) {
-      summary.AddRow({option, value, FormatFixed(cell.first / cell.second, 3), std::to_string(cell.second)});
+      SweepValueSummary summary{option, value, static_cast<int>(cell.rmse.size())};
+      summary.short_runs = cell.short_runs;
+      if (!cell.rmse.empty()) {
+        summary.mean_rmse_mm = mean(cell.rmse);
+        summary.median_rmse_mm = Median(cell.rmse);
+        if (cell.ate_everywhere) summary.mean_ate_mm = mean(cell.ate);
+      }
+      summaries.push_back(summary);
     }
   }
-  summary.Print(out);
+  return summaries;
 }
 
 Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance& tolerance) {

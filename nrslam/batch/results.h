@@ -42,9 +42,21 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
 // Reads a folder's results.json; throws Error if it has none.
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder);
 
+// One value of one swept option, over the sequences tracked to the end at every point of the
+// sweep, so that every value is averaged over the same sequences (a value that loses a hard
+// sequence would otherwise look better for it).
+struct SweepValueSummary {
+  std::string option, value;
+  int runs = 0;                  // runs averaged: one per sequence complete at every point
+  double mean_rmse_mm = 0, median_rmse_mm = 0;
+  double mean_ate_mm = -1;       // negative: one of those runs has no trajectory error
+  int short_runs = 0;            // runs at this value, over every sequence, failed or lost before the end
+};
+// Per option, values in numeric order when they are numbers ("5" before "10"), else as text.
+std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results);
+
 // The table a person reads: sequence, [sweep point], status, init frame, tracked/total,
-// RMSE mean and median (mm), trajectory error (mm), fps. With sweeps, also the mean RMSE per value of each option
-// over the sequences tracked at every point.
+// RMSE mean and median (mm), trajectory error (mm), fps. With sweeps, also SummariseSweep's table.
 void PrintResults(const std::vector<RunResult>& results, std::ostream& out);
 
 // A regression baseline: per run key (sequence [label]), RMSE and frames tracked, plus the
