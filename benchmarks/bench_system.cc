@@ -3,7 +3,7 @@
 // (reading images and writing the run folder included; rendering is done beforehand and
 // not timed). Prints fps, mean ms per frame of each stage and the peak resident memory.
 // Targets: >= 15 fps; <= 1 GB on a 1000-frame run.
-//   bench_system [FRAMES=120] [PRESET...]      e.g. bench_system 1000 sim-3
+//   bench_system [FRAMES=120] [PRESET...] [--set module.option=value ...]   e.g. bench_system 1000 sim-3
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -16,6 +16,8 @@
 
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
+#include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace fs = std::filesystem;
 
@@ -25,7 +27,19 @@ int main(int argc, char** argv) {
   std::vector<std::string> presets = {"sim-0", "sim-3", "sim-6"};
   app.add_option("frames", frames, "frames per sequence")->check(CLI::Range(2, 100000));
   app.add_option("presets", presets, "simulator presets")->check(CLI::IsMember(nrslam::SimPresetNames()));
+  std::vector<std::string> assignments;
+  app.add_option("--set", assignments, "options of both modes, as nrslam_run's --set (e.g. --set mapping.dba_lag_frames=2)");
   CLI11_PARSE(app, argc, argv);
+  nrslam::SystemOptions options;
+  options.run.init = "monocular";
+  try {
+    for (std::string& assignment : assignments) assignment = nrslam::ResolveRunAssignment(assignment);
+    options = nrslam::WithAssignments(options, assignments);
+  } catch (const nrslam::Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  for (const std::string& assignment : assignments) std::printf("set %s\n", assignment.c_str());
   const fs::path work = fs::temp_directory_path() / ("nrslam_bench_system_" + std::to_string(::getpid()));
   std::printf("%-8s %-10s %6s %7s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
               "DBA ms", "triang ms", "RMSE mm", "points");
@@ -34,10 +48,9 @@ int main(int argc, char** argv) {
     sim.frames = frames;
     nrslam::SimulateSequence(sim, preset, work / preset);
     for (const bool rigid : {false, true}) {
-      nrslam::SystemOptions options;
-      options.run.init = "monocular";
-      options.tracking.rigid = rigid;
-      const nrslam::RunSummary s = nrslam::RunSequence(work / preset, options, work / (preset + "-run"));
+      nrslam::SystemOptions mode = options;
+      mode.tracking.rigid = rigid;
+      const nrslam::RunSummary s = nrslam::RunSequence(work / preset, mode, work / (preset + "-run"));
       std::printf("%-8s %-10s %6d %7.1f %9.2f %9.2f %9.2f %9.2f %9.2f %8zu\n", preset.c_str(),
                   rigid ? "rigid" : "deformable", s.frames_tracked, s.fps, s.ms_initialisation, s.ms_tracking, s.ms_dba,
                   s.ms_triangulation, s.rmse_mm, s.map_points);

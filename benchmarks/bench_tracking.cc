@@ -1,7 +1,7 @@
 // Tracking speed at 640x480: frames per second of tracking alone (rendering excluded) and
 // milliseconds per stage on a few presets: deformable (sparse Cholesky, the default), deformable
 // with the CGNR joint solver, and rigid. Target: >= 30 fps.
-//   bench_tracking [FRAMES=60]
+//   bench_tracking [FRAMES=60] [--set module.option=value ...]
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -9,13 +9,27 @@
 #include <vector>
 
 #include "nrslam/sim/renderer.h"
+#include "nrslam/system/system_options.h"
 #include "nrslam/tracking/tracker.h"
+#include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Tracking speed at 640x480 from a depth-initialised map (sim-0, sim-3, sim-6)"};
   int frames = 60;
   app.add_option("frames", frames, "frames per preset, the first one initialising")->check(CLI::Range(2, 100000));
+  std::vector<std::string> assignments;
+  app.add_option("--set", assignments, "options of every mode, as nrslam_run's --set (e.g. --set tracking.displacement_prior_sigma=0.2)");
   CLI11_PARSE(app, argc, argv);
+  nrslam::SystemOptions options;
+  try {
+    for (std::string& assignment : assignments) assignment = nrslam::ResolveRunAssignment(assignment);
+    options = nrslam::WithAssignments(options, assignments);
+  } catch (const nrslam::Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  for (const std::string& assignment : assignments) std::printf("set %s\n", assignment.c_str());
   std::printf("%-8s %-10s %7s %8s %8s %8s %8s %8s\n", "preset", "mode", "fps", "klt ms", "pose ms", "deform ms",
               "total ms", "points");
   for (const std::string preset : {"sim-0", "sim-3", "sim-6"}) {
@@ -23,10 +37,10 @@ int main(int argc, char** argv) {
     std::vector<nrslam::RenderedFrame> rendered;
     for (int i = 0; i < frames; ++i) rendered.push_back(renderer.Render(i));
     for (const std::string mode : {"deformable", "cgnr", "rigid"}) {
-      nrslam::TrackingOptions tracking;
+      nrslam::TrackingOptions tracking = options.tracking;
       tracking.rigid = mode == "rigid";
       if (mode == "cgnr") tracking.joint_linear_solver = "cgnr";
-      nrslam::Tracker tracker(renderer.camera(), nrslam::FrontendOptions{}, nrslam::DeformationModelOptions{}, tracking);
+      nrslam::Tracker tracker(renderer.camera(), options.frontend, options.deformation, tracking);
       tracker.InitialiseFromDepth(0, rendered[0].left.bgr, rendered[0].left.depth_mm, {});
       double klt = 0, pose = 0, deformation = 0, total = 0, points = 0;
       int tracked = 0;
