@@ -14,10 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
-#include "nrslam/util/error.h"
-#include "nrslam/util/json_options.h"
 
 namespace fs = std::filesystem;
 
@@ -30,16 +29,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> assignments;
   app.add_option("--set", assignments, "options of both modes, as nrslam_run's --set (e.g. --set mapping.dba_lag_frames=2)");
   CLI11_PARSE(app, argc, argv);
-  nrslam::SystemOptions options;
-  options.run.init = "monocular";
-  try {
-    for (std::string& assignment : assignments) assignment = nrslam::ResolveRunAssignment(assignment);
-    options = nrslam::WithAssignments(options, assignments);
-  } catch (const nrslam::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
-  for (const std::string& assignment : assignments) std::printf("set %s\n", assignment.c_str());
+  const std::optional<nrslam::SystemOptions> options = BenchmarkOptions(assignments);
+  if (!options) return 1;
   const fs::path work = fs::temp_directory_path() / ("nrslam_bench_system_" + std::to_string(::getpid()));
   std::printf("%-8s %-10s %6s %7s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
               "DBA ms", "triang ms", "RMSE mm", "points");
@@ -48,7 +39,7 @@ int main(int argc, char** argv) {
     sim.frames = frames;
     nrslam::SimulateSequence(sim, preset, work / preset);
     for (const bool rigid : {false, true}) {
-      nrslam::SystemOptions mode = options;
+      nrslam::SystemOptions mode = *options;
       mode.tracking.rigid = rigid;
       const nrslam::RunSummary s = nrslam::RunSequence(work / preset, mode, work / (preset + "-run"));
       std::printf("%-8s %-10s %6d %7.1f %9.2f %9.2f %9.2f %9.2f %9.2f %8zu\n", preset.c_str(),

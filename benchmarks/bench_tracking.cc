@@ -8,11 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "nrslam/sim/renderer.h"
-#include "nrslam/system/system_options.h"
 #include "nrslam/tracking/tracker.h"
-#include "nrslam/util/error.h"
-#include "nrslam/util/json_options.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Tracking speed at 640x480 from a depth-initialised map (sim-0, sim-3, sim-6)"};
@@ -21,15 +19,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> assignments;
   app.add_option("--set", assignments, "options of every mode, as nrslam_run's --set (e.g. --set tracking.displacement_prior_sigma=0.2)");
   CLI11_PARSE(app, argc, argv);
-  nrslam::SystemOptions options;
-  try {
-    for (std::string& assignment : assignments) assignment = nrslam::ResolveRunAssignment(assignment);
-    options = nrslam::WithAssignments(options, assignments);
-  } catch (const nrslam::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
-  for (const std::string& assignment : assignments) std::printf("set %s\n", assignment.c_str());
+  const std::optional<nrslam::SystemOptions> options = BenchmarkOptions(assignments);
+  if (!options) return 1;
   std::printf("%-8s %-10s %7s %8s %8s %8s %8s %8s\n", "preset", "mode", "fps", "klt ms", "pose ms", "deform ms",
               "total ms", "points");
   for (const std::string preset : {"sim-0", "sim-3", "sim-6"}) {
@@ -37,10 +28,10 @@ int main(int argc, char** argv) {
     std::vector<nrslam::RenderedFrame> rendered;
     for (int i = 0; i < frames; ++i) rendered.push_back(renderer.Render(i));
     for (const std::string mode : {"deformable", "cgnr", "rigid"}) {
-      nrslam::TrackingOptions tracking = options.tracking;
+      nrslam::TrackingOptions tracking = options->tracking;
       tracking.rigid = mode == "rigid";
       if (mode == "cgnr") tracking.joint_linear_solver = "cgnr";
-      nrslam::Tracker tracker(renderer.camera(), options.frontend, options.deformation, tracking);
+      nrslam::Tracker tracker(renderer.camera(), options->frontend, options->deformation, tracking);
       tracker.InitialiseFromDepth(0, rendered[0].left.bgr, rendered[0].left.depth_mm, {});
       double klt = 0, pose = 0, deformation = 0, total = 0, points = 0;
       int tracked = 0;

@@ -222,6 +222,12 @@ TEST(SystemOptionsNames, UniqueLastNamesResolveToFullPaths) {
   EXPECT_THROW(ResolveRunAssignment("min_points=5"), Error);  // evaluation, initialisation and tracking
   EXPECT_THROW(ResolveRunAssignment("kk=2"), Error);
   EXPECT_THROW(ResolveRunAssignment("k"), Error);
+  // A command line's --set list: short names resolved, applied in order, values checked.
+  const SystemOptions set = WithRunAssignments(SystemOptions{}, {"k=2", "mapping.dba_window=7", "k=3"});
+  EXPECT_EQ(set.deformation.k, 3);
+  EXPECT_EQ(set.mapping.dba_window, 7);
+  EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"kk=2"}), Error);
+  EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"displacement_prior_sigma=-1"}), Error);
 }
 
 TEST(SystemOptionsNames, AssignmentsOverTheDefaultsGiveTheOptionsBack) {

@@ -28,8 +28,7 @@ int main(int argc, char** argv) {
     if (!init.empty()) options.run.init = init;
     if (rigid) options.tracking.rigid = true;
     if (no_mapping) options.run.mapping = false;
-    for (std::string& assignment : assignments) assignment = nrslam::ResolveRunAssignment(assignment);
-    options = nrslam::WithAssignments(options, assignments);
+    options = nrslam::WithRunAssignments(options, assignments);
     if (print_options) {
       std::cout << nrslam::Json(options).dump(2) << '\n';
       return 0;

@@ -44,4 +44,10 @@ std::string ResolveRunAssignment(const std::string& assignment) {
   return ResolveRunOption(assignment.substr(0, equals)) + assignment.substr(equals);
 }
 
+SystemOptions WithRunAssignments(const SystemOptions& options, const std::vector<std::string>& assignments) {
+  std::vector<std::string> resolved;
+  for (const std::string& assignment : assignments) resolved.push_back(ResolveRunAssignment(assignment));
+  return WithAssignments(options, resolved);
+}
+
 }  // namespace nrslam

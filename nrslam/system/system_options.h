@@ -66,5 +66,8 @@ std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options);
 std::string ResolveRunOption(const std::string& name);
 // "name=value" with the name resolved as above; throws Error without an "=".
 std::string ResolveRunAssignment(const std::string& assignment);
+// `options` with a command line's --set list applied in order, names resolved as above;
+// throws Error on an unknown name or a value the options' Check() refuses.
+SystemOptions WithRunAssignments(const SystemOptions& options, const std::vector<std::string>& assignments);
 
 }  // namespace nrslam
