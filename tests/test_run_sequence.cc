@@ -265,6 +265,27 @@ TEST(SystemOptionsFile, PartialOptionsOverTheDefaultsAndUnknownKeysRejected) {
   fs::remove_all(folder);
 }
 
+// The sum of a metrics.csv column over the frames.
+double SumColumn(const fs::path& csv, const std::string& column) {
+  std::ifstream file(csv);
+  std::string line, field;
+  std::getline(file, line);
+  std::istringstream header(line);
+  int index = 0, wanted = -1;
+  while (std::getline(header, field, ',')) {
+    if (field == column) wanted = index;
+    ++index;
+  }
+  double sum = 0;
+  while (wanted >= 0 && std::getline(file, line)) {
+    std::istringstream fields(line);
+    for (int i = 0; i <= wanted && std::getline(fields, field, ','); ++i) {
+      if (i == wanted) sum += std::stod(field);
+    }
+  }
+  return sum;
+}
+
 TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   const fs::path run = *base_ / "run";
   for (const char* file : {"config.json", "trajectory.tum", "points.csv", "metrics.csv", "summary.json", "map.ply",
@@ -278,6 +299,13 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   EXPECT_TRUE(fs::exists(run / "depth" / "000039.png"));
   std::ifstream metrics(run / "metrics.csv");
   EXPECT_EQ(std::count(std::istreambuf_iterator<char>(metrics), {}, '\n'), 41);  // header + one per frame
+  // The solver timings are parts of the deformation stage's, which is what they break down.
+  const double deformation = SumColumn(run / "metrics.csv", "ms_deformation");
+  const double joint_solve = SumColumn(run / "metrics.csv", "ms_joint_solve");
+  const double linear_solve = SumColumn(run / "metrics.csv", "ms_linear_solve");
+  EXPECT_GT(linear_solve, 0.0);
+  EXPECT_LE(linear_solve, joint_solve);
+  EXPECT_LE(joint_solve, deformation);
 }
 
 // The full system from the images alone (depth only for the evaluation), at 320x240, 60 frames.
@@ -296,25 +324,6 @@ int CountLines(const fs::path& file, const std::string& text) {
   return count;
 }
 
-int SumColumn(const fs::path& csv, const std::string& column) {
-  std::ifstream file(csv);
-  std::string line, field;
-  std::getline(file, line);
-  std::istringstream header(line);
-  int index = 0, wanted = -1;
-  while (std::getline(header, field, ',')) {
-    if (field == column) wanted = index;
-    ++index;
-  }
-  int sum = 0;
-  while (wanted >= 0 && std::getline(file, line)) {
-    std::istringstream fields(line);
-    for (int i = 0; i <= wanted && std::getline(fields, field, ','); ++i) {
-      if (i == wanted) sum += std::stoi(field);
-    }
-  }
-  return sum;
-}
 
 MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& options) {
   const fs::path folder = UniqueTempFolder("nrslam_monocular_" + preset);
@@ -334,7 +343,7 @@ MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& op
     evaluations.push_back(EvaluateFrame(depth_points, reader.ReadDepthMm(frame), EvaluationOptions{}));
   }
   outcome.flat_rmse = AggregateFrames(evaluations).rmse_mm;
-  outcome.deformable_candidates = SumColumn(folder / "run" / "metrics.csv", "deformable_candidates");
+  outcome.deformable_candidates = static_cast<int>(SumColumn(folder / "run" / "metrics.csv", "deformable_candidates"));
   outcome.rigid_dba = CountLines(folder / "run" / "run.log", "DBA rigid");
   outcome.deformable_dba = CountLines(folder / "run" / "run.log", "DBA deformable");
   std::cout << preset << " monocular 320x240: init at " << outcome.summary.init_frame << ", " << outcome.new_points

@@ -149,7 +149,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   points_csv << "frame,point_id,u,v,z_est,x,y,z,status\n";
   std::ofstream metrics_csv = OpenForWriting(out / "metrics.csv");
   metrics_csv << "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,deformable_candidates,new_points,"
-                 "points_without_gt,scale,rmse_mm,ms_klt,ms_pose,ms_deformation,ms_dba,ms_triangulation,ms_total,note\n";
+                 "points_without_gt,scale,rmse_mm,ms_klt,ms_pose,ms_deformation,ms_dba,ms_triangulation,ms_total,"
+                 "ms_joint_solve,ms_linear_solve,note\n";
   std::ofstream log = OpenForWriting(out / "run.log");
 
   Tracker tracker(camera, options.frontend, options.deformation, options.tracking);
@@ -269,8 +270,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                 << evaluation.points_without_groundtruth << ',' << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
                 << (evaluation.evaluated ? std::to_string(evaluation.rmse_mm) : std::string()) << ','
                 << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
-                << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation
-                << ",\"" << result.note << "\"\n";
+                << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation << ','
+                << result.ms_joint_solve << ',' << result.ms_linear_solve << ",\"" << result.note << "\"\n";
     if (progress) {
       std::ostringstream line;
       line << "frame " << frame + 1 - first << "/" << summary.frames_total << "  " << ToString(result.state) << "  "

@@ -303,7 +303,8 @@ std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observatio
 }
 
 void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
-                               std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const {
+                               std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers,
+                               FrameResult* timings) const {
   const size_t n = observations.size();
   // Observation index by point id (−1: not observed); a dense table because the graph asks
   // it for every edge of every observed point.
@@ -393,6 +394,8 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
     }
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
+    timings->ms_joint_solve += 1e3 * summary.total_time_in_seconds;
+    timings->ms_linear_solve += 1e3 * summary.linear_solver_time_in_seconds;
     const Rigid3 estimate = Rigid3::FromParams(params.data());
     for (size_t i = 0; i < n; ++i) {
       (*inliers)[i] = SquaredReprojectionError(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
@@ -464,7 +467,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
   std::vector<bool> demoted(observations.size(), false);
   if (!options_.rigid) {
-    SolveDeformation(observations, &pose, &displacements, &inliers);
+    SolveDeformation(observations, &pose, &displacements, &inliers, &result);
     // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
     std::vector<double> norms;
     for (const auto& d : displacements) norms.push_back(d.norm());

@@ -55,6 +55,9 @@ struct FrameResult {
   int propagated = 0;                // lost or demoted points moved with their neighbours
   int reassociated = 0;              // lost points found again
   double ms_klt = 0, ms_pose = 0, ms_deformation = 0, ms_total = 0;
+  // Inside ms_deformation: Ceres's time in the joint solves (all rounds), and the part of it
+  // spent in the linear solver (factorising or CG), which is where deformable tracking's time goes.
+  double ms_joint_solve = 0, ms_linear_solve = 0;
   std::string note;                  // why a frame is not tracked
 };
 
@@ -139,9 +142,11 @@ class Tracker {
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   std::vector<bool> RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const;
-  // The joint pose + displacement problem; fills displacements and inlier flags.
+  // The joint pose + displacement problem; fills displacements and inlier flags, and the
+  // result's solver timings.
   void SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
-                        std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
+                        std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers,
+                        FrameResult* timings) const;
   // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
   // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.
   // `optimised` is indexed by point id (nullopt: not optimised this frame).
