@@ -48,6 +48,9 @@ TEST(JsonOptions, TrackingLinearSolverIsAChoiceOfTwo) {
   EXPECT_EQ(cgnr.joint_linear_solver, "cgnr");
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(cgnr), "test").joint_linear_solver, "cgnr");
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"joint_linear_solver=qr"}), Error);
+  const TrackingOptions dogleg = WithAssignments(TrackingOptions{}, {"joint_trust_region=dogleg"});
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(dogleg), "test").joint_trust_region, "dogleg");
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"joint_trust_region=newton"}), Error);
 }
 
 TEST(JsonOptions, DisplacementPriorIsOffByDefaultAndNeverNegative) {

@@ -366,9 +366,10 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Ceres's default preconditioner for CGNR is block Jacobi.
-  const ceres::Solver::Options solver_options = SolverOptions(
+  ceres::Solver::Options solver_options = SolverOptions(
       options_.deformation_iterations,
       options_.joint_linear_solver == "cgnr" ? ceres::CGNR : ceres::SPARSE_NORMAL_CHOLESKY);
+  if (options_.joint_trust_region == "dogleg") solver_options.trust_region_strategy_type = ceres::DOGLEG;
   for (int round = 0; round < options_.deformation_rounds; ++round) {
     params = rigid;  // every round restarts from the rigid pose and δ = 0
     displacements->assign(n, Eigen::Vector3d::Zero());

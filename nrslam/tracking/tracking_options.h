@@ -21,6 +21,10 @@ struct TrackingOptions {
   // or "cgnr" (conjugate gradients, block-Jacobi preconditioned: the deformation stage ~1.35×
   // faster, as accurate when tracking alone, but less accurate with mapping; README "Tracking").
   std::string joint_linear_solver = "sparse_cholesky";
+  // Trust-region strategy of that problem: "levenberg_marquardt" (the reference) or "dogleg",
+  // which re-uses a step's linear solve when the region shrinks instead of factorising again:
+  // tracking 0–14 % faster, accuracy mixed over the seed renderings (README "Tracking").
+  std::string joint_trust_region = "levenberg_marquardt";
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
   double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
   // σ of a zero-mean prior on each point's displacement δ, in map-scale units (0: none, the
@@ -37,7 +41,7 @@ struct TrackingOptions {
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
-                                                deformation_iterations, joint_linear_solver, outlier_chi2, displacement_iqr_factor,
+                                                deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
                                                 displacement_prior_sigma,
                                                 reassociation, reassociation_levels, reassociation_gate_px2,
                                                 lost_max_age_frames)
