@@ -306,6 +306,12 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   EXPECT_GT(linear_solve, 0.0);
   EXPECT_LE(linear_solve, joint_solve);
   EXPECT_LE(joint_solve, deformation);
+  nlohmann::json summary;
+  std::ifstream(run / "summary.json") >> summary;
+  const nlohmann::json& per_frame = summary.at("ms_per_frame");
+  EXPECT_NEAR(per_frame.at("tracking_linear_solve").get<double>(), linear_solve / 40.0,
+              1e-4 * linear_solve);  // metrics.csv holds 6 significant digits
+  EXPECT_LT(per_frame.at("tracking_linear_solve").get<double>(), per_frame.at("tracking").get<double>());
 }
 
 // The full system from the images alone (depth only for the evaluation), at 320x240, 60 frames.

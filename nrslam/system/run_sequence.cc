@@ -159,7 +159,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   MonocularInitialiser initialiser(camera, options.frontend, options.tracking.max_points, options.initialisation);
   const bool monocular = options.run.init == "monocular";
   int maps = 0;  // maps started so far: a monocular run starts a new one after each loss
-  double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
+  double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
   const auto start_map = [&](const FrameResult& started, const std::optional<Keyframe>& reference) {
@@ -229,6 +229,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     }
 
     ms_tracking += result.ms_total;
+    ms_tracking_linear_solve += result.ms_linear_solve;
     ms_dba += mapping.ms_dba;
     ms_triangulation += mapping.ms_triangulation;
     FrameEvaluation evaluation;
@@ -286,6 +287,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.fps = summary.frames_total / std::max(seconds, 1e-9);
   summary.ms_initialisation = ms_initialisation / summary.frames_total;
   summary.ms_tracking = ms_tracking / summary.frames_total;
+  summary.ms_tracking_linear_solve = ms_tracking_linear_solve / summary.frames_total;
   summary.ms_dba = ms_dba / summary.frames_total;
   summary.ms_triangulation = ms_triangulation / summary.frames_total;
   summary.maps = maps;
@@ -312,6 +314,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                                  {"fps", summary.fps},
                                  {"ms_per_frame", {{"initialisation", summary.ms_initialisation},
                                                    {"tracking", summary.ms_tracking},
+                                                   {"tracking_linear_solve", summary.ms_tracking_linear_solve},
                                                    {"dba", summary.ms_dba},
                                                    {"triangulation", summary.ms_triangulation}}},
                                  {"maps", summary.maps},

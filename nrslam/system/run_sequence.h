@@ -30,6 +30,7 @@ struct RunSummary {
   double fps = 0;          // frames processed per second of wall time (reading included)
   // Mean milliseconds per processed frame in each stage (the mapping stages run on some frames only).
   double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
+  double ms_tracking_linear_solve = 0;  // of ms_tracking: the joint solves' linear solver
   TrajectoryError trajectory_error;  // camera centres aligned to the ground-truth poses per map
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
