@@ -1,4 +1,4 @@
-// deformation: the elastic (spring) and viscous (damper) regularisers as Ceres functors.
+// deformation: the elastic (spring) and viscous (damper) regularisers as Ceres cost functions.
 //
 // Both residuals are linear in what they penalise, times a multiplier that carries the
 // weighting (deformation_options.h), so that the squared residual is the energy:
@@ -26,7 +26,7 @@ double ViscousMultiplier(const DeformationModelOptions& options, double edge_wei
 // Spring between two points whose positions are base + parameter: in tracking the bases are
 // the previous positions and the parameters the displacements δ; in DBA the bases are zero
 // and the parameters a keyframe's positions x^k. Analytic Jacobians: tracking evaluates
-// thousands of these per iteration (bench_tracking: the deformation stage 3–7 % faster).
+// thousands of these per iteration (bench_tracking: the deformation stage 1–7 % faster).
 class ElasticCost final : public ceres::SizedCostFunction<1, 3, 3> {
  public:
   ElasticCost(const Eigen::Vector3d& base_i, const Eigen::Vector3d& base_j, double rest_length, double multiplier)

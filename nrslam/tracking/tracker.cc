@@ -302,9 +302,9 @@ std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observatio
   return inliers;
 }
 
-void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
-                               std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers,
-                               FrameResult* timings) const {
+Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
+                                                   std::vector<Eigen::Vector3d>* displacements,
+                                                   std::vector<bool>* inliers) const {
   const size_t n = observations.size();
   // Observation index by point id (−1: not observed); a dense table because the graph asks
   // it for every edge of every observed point.
@@ -370,6 +370,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
       options_.deformation_iterations,
       options_.joint_linear_solver == "cgnr" ? ceres::CGNR : ceres::SPARSE_NORMAL_CHOLESKY);
   if (options_.joint_trust_region == "dogleg") solver_options.trust_region_strategy_type = ceres::DOGLEG;
+  JointSolveTimes times;
   for (int round = 0; round < options_.deformation_rounds; ++round) {
     params = rigid;  // every round restarts from the rigid pose and δ = 0
     displacements->assign(n, Eigen::Vector3d::Zero());
@@ -395,8 +396,8 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
     }
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
-    timings->ms_joint_solve += 1e3 * summary.total_time_in_seconds;
-    timings->ms_linear_solve += 1e3 * summary.linear_solver_time_in_seconds;
+    times.ms_total += 1e3 * summary.total_time_in_seconds;
+    times.ms_linear += 1e3 * summary.linear_solver_time_in_seconds;
     const Rigid3 estimate = Rigid3::FromParams(params.data());
     for (size_t i = 0; i < n; ++i) {
       (*inliers)[i] = SquaredReprojectionError(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
@@ -411,6 +412,7 @@ void Tracker::SolveDeformation(const std::vector<Observation>& observations, Rig
     }
   }
   *pose = Rigid3::FromParams(params.data());
+  return times;
 }
 
 FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
@@ -468,7 +470,9 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
   std::vector<bool> demoted(observations.size(), false);
   if (!options_.rigid) {
-    SolveDeformation(observations, &pose, &displacements, &inliers, &result);
+    const JointSolveTimes times = SolveDeformation(observations, &pose, &displacements, &inliers);
+    result.ms_joint_solve = times.ms_total;
+    result.ms_linear_solve = times.ms_linear;
     // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
     std::vector<double> norms;
     for (const auto& d : displacements) norms.push_back(d.norm());

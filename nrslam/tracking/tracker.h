@@ -142,11 +142,13 @@ class Tracker {
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   std::vector<bool> RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const;
-  // The joint pose + displacement problem; fills displacements and inlier flags, and the
-  // result's solver timings.
-  void SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
-                        std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers,
-                        FrameResult* timings) const;
+  // Ceres's time in the joint solves of one frame, all rounds.
+  struct JointSolveTimes {
+    double ms_total = 0, ms_linear = 0;
+  };
+  // The joint pose + displacement problem; fills displacements and inlier flags.
+  JointSolveTimes SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
+                                   std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
   // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
   // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.
   // `optimised` is indexed by point id (nullopt: not optimised this frame).
