@@ -84,7 +84,7 @@ TEST(DeformationGraph, PrunesEdgesBetweenSeparatingClusters) {
   EXPECT_EQ(edges, 16u * 15u / 2u);
   for (int step = 1; step <= 30; ++step) {  // B slides away rigidly
     for (int i = 0; i < 8; ++i) positions.at[100 + i].x() += 0.2;
-    for (const PointId id : positions.Ids()) graph.UpdatePoint(id, positions.Lookup());
+    graph.UpdatePoints(positions.Ids(), positions.Lookup());
   }
   size_t across_pruned = 0, within_pruned = 0;
   for (size_t e = 0; e < graph.edge_count(); ++e) {
@@ -109,16 +109,16 @@ TEST(DeformationGraph, WeightFollowsTheLongestLengthEverSeen) {
   positions.at = {{1, {0, 0, 0}}, {2, {1, 0, 0}}};
   graph.ConnectCovisible({1, 2}, {}, positions.Lookup());
   positions.at[2] = {1.5, 0, 0};
-  graph.UpdatePoint(1, positions.Lookup());
+  graph.UpdatePoints({1}, positions.Lookup());
   positions.at[2] = {1.0, 0, 0};  // back to rest: the weight does not recover
-  graph.UpdatePoint(2, positions.Lookup());
+  graph.UpdatePoints({2}, positions.Lookup());
   const GraphEdge& edge = graph.edge(0);
   EXPECT_DOUBLE_EQ(edge.max_length, 1.5);
   EXPECT_DOUBLE_EQ(edge.min_length, 1.0);
   EXPECT_DOUBLE_EQ(edge.weight, std::exp(-1.5 * 1.5 / 2.0));
   EXPECT_FALSE(edge.pruned);  // stretch 0.5 < 1.1
   positions.at[2] = {0.4, 0, 0};  // d_min 0.4: (1.5 − 0.4)/0.4 = 2.75 > 1.1
-  graph.UpdatePoint(2, positions.Lookup());
+  graph.UpdatePoints({2}, positions.Lookup());
   EXPECT_TRUE(graph.edge(0).pruned);
 }
 
@@ -149,7 +149,7 @@ TEST(DeformationGraph, FlagsPointsLeftWithTooFewEdges) {
   graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
   EXPECT_FALSE(graph.IsWeaklyConnected(1));
   positions.at[1] = {-5, -5, 0};  // point 1 tears away from both
-  graph.UpdatePoint(1, positions.Lookup());
+  graph.UpdatePoints({1}, positions.Lookup());
   EXPECT_EQ(graph.GoodEdgeCount(1), 0);
   EXPECT_TRUE(graph.IsWeaklyConnected(1));
   EXPECT_THROW(graph.set_sigma(0.0), Error);
@@ -169,7 +169,7 @@ TEST(DeformationGraph, CountsAndBestEdgesAgreeWithTheEdgeRecordsAfterUpdates) {
   graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
   for (int step = 0; step < 12; ++step) {
     for (auto& [id, position] : positions.at) position += Eigen::Vector3d(jitter(random), jitter(random), jitter(random));
-    for (const PointId id : positions.Ids()) graph.UpdatePoint(id, positions.Lookup());
+    graph.UpdatePoints(positions.Ids(), positions.Lookup());
     if (step == 5) graph.set_sigma(1.0);
     if (step == 8) graph.ResetRestShape({0, 1, 2, 3, 4, 5}, positions.Lookup());
   }

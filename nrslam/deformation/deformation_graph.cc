@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "nrslam/util/error.h"
 
@@ -98,14 +99,36 @@ void DeformationGraph::ConnectCovisible(const std::vector<PointId>& new_points, 
   }
 }
 
-void DeformationGraph::UpdatePoint(PointId point, const PositionLookup& position) {
-  const auto node = nodes_.find(point);
-  if (node == nodes_.end()) return;
-  const auto here = position(point);
-  if (!here) return;
-  for (const Incidence& incidence : node->second.edges) {
-    const auto there = position(incidence.other);
-    if (there) Remeasure(incidence.edge, (*here - *there).norm());
+namespace {
+
+// Position of each id in `points` (−1: not there), as a table indexed by id: the graph asks it
+// for every edge of every point, hundreds per point.
+std::vector<int> PositionsInList(const std::vector<PointId>& points) {
+  PointId largest = -1;
+  for (PointId id : points) largest = std::max(largest, id);
+  std::vector<int> position(static_cast<size_t>(largest + 1), -1);
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (points[k] < 0) throw Error("deformation graph: point ids are map indices, got " + std::to_string(points[k]));
+    position[static_cast<size_t>(points[k])] = static_cast<int>(k);
+  }
+  return position;
+}
+
+}  // namespace
+
+void DeformationGraph::UpdatePoints(const std::vector<PointId>& points, const PositionLookup& position) {
+  const std::vector<int> listed = PositionsInList(points);
+  const auto is_listed = [&](PointId id) { return static_cast<size_t>(id) < listed.size() && listed[static_cast<size_t>(id)] >= 0; };
+  for (PointId point : points) {
+    const auto node = nodes_.find(point);
+    if (node == nodes_.end()) continue;
+    const auto here = position(point);
+    if (!here) continue;
+    for (const Incidence& incidence : node->second.edges) {
+      if (incidence.other < point && is_listed(incidence.other)) continue;  // measured from its other end
+      const auto there = position(incidence.other);
+      if (there) Remeasure(incidence.edge, (*here - *there).norm());
+    }
   }
 }
 
@@ -129,25 +152,54 @@ void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const 
   }
 }
 
-std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
-                                                             const std::function<bool(PointId)>& eligible) const {
-  std::vector<GraphNeighbour> neighbours;
+template <typename Eligible>
+void DeformationGraph::SelectBest(PointId point, const Eligible& eligible, std::vector<GraphNeighbour>* best) const {
+  best->clear();
   const auto node = nodes_.find(point);
-  if (node == nodes_.end()) return neighbours;
+  if (node == nodes_.end()) return;
   for (const auto& [other, index] : node->second.edges) {
     const double weight = ranking_weight_[index];
     if (weight < 0.0) continue;
-    if (eligible && !eligible(other)) continue;
-    neighbours.push_back({other, index, weight});
+    if (!eligible(other)) continue;
+    best->push_back({other, index, weight});
   }
-  const size_t keep = std::min(neighbours.size(), static_cast<size_t>(options_.max_degree_D));
+  const size_t keep = std::min(best->size(), static_cast<size_t>(options_.max_degree_D));
   // Ties broken by id so the choice never depends on insertion order.
-  std::partial_sort(neighbours.begin(), neighbours.begin() + keep, neighbours.end(),
+  std::partial_sort(best->begin(), best->begin() + keep, best->end(),
                     [](const GraphNeighbour& x, const GraphNeighbour& y) {
                       return x.weight != y.weight ? x.weight > y.weight : x.id < y.id;
                     });
-  neighbours.resize(keep);
-  return neighbours;
+  best->resize(keep);
+}
+
+std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
+                                                             const std::function<bool(PointId)>& eligible) const {
+  std::vector<GraphNeighbour> best;
+  if (eligible) {
+    SelectBest(point, eligible, &best);
+  } else {
+    SelectBest(point, [](PointId) { return true; }, &best);
+  }
+  return best;
+}
+
+std::vector<GraphPair> DeformationGraph::PairsAmong(const std::vector<PointId>& points) const {
+  const std::vector<int> listed = PositionsInList(points);
+  const auto is_listed = [&](PointId id) { return static_cast<size_t>(id) < listed.size() && listed[static_cast<size_t>(id)] >= 0; };
+  std::vector<std::vector<size_t>> chosen(points.size());  // each point's neighbours, at most D
+  std::vector<GraphPair> pairs;
+  std::vector<GraphNeighbour> best;
+  for (size_t i = 0; i < points.size(); ++i) {
+    SelectBest(points[i], is_listed, &best);
+    for (const GraphNeighbour& neighbour : best) {
+      const auto j = static_cast<size_t>(listed[static_cast<size_t>(neighbour.id)]);
+      chosen[i].push_back(j);
+      // With a point listed earlier, the pair exists already if that point chose this one.
+      if (j < i && std::find(chosen[j].begin(), chosen[j].end(), i) != chosen[j].end()) continue;
+      pairs.push_back({i, j, neighbour.edge, neighbour.weight});
+    }
+  }
+  return pairs;
 }
 
 int DeformationGraph::GoodEdgeCount(PointId point) const {

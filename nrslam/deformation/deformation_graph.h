@@ -38,6 +38,14 @@ struct GraphNeighbour {
   double weight;  // b of that edge
 };
 
+// A regularised pair among a list of points: their positions in that list, i the one whose
+// best D edges chose the pair first, j its neighbour.
+struct GraphPair {
+  size_t i, j;
+  int edge;       // index into DeformationGraph::edge()
+  double weight;  // b of that edge
+};
+
 // Current position of a point, or nullopt if it has none now.
 using PositionLookup = std::function<std::optional<Eigen::Vector3d>(PointId)>;
 
@@ -55,9 +63,10 @@ class DeformationGraph {
   // position: the points co-visible at creation.
   void ConnectCovisible(const std::vector<PointId>& new_points, const std::vector<PointId>& existing,
                         const PositionLookup& position);
-  // Re-measures the point's edges from current positions: d_min, d_max, b, pruning.
-  // Neighbours without a position keep their edge untouched.
-  void UpdatePoint(PointId point, const PositionLookup& position);
+  // Re-measures the edges of `points` from current positions: d_min, d_max, b, pruning. An edge
+  // between two of them is measured once. Neighbours without a position keep their edge
+  // untouched. Ids are map indices (a table as long as the largest one is built).
+  void UpdatePoints(const std::vector<PointId>& points, const PositionLookup& position);
 
   // Takes the current lengths of the edges among `points` as their rest lengths (and d_min,
   // d_max): for a map whose structure was re-estimated, not deformed.
@@ -67,6 +76,10 @@ class DeformationGraph {
   // neighbours that pass `eligible` (all if empty): e.g. only the points tracked this frame,
   // so lost neighbours do not use up the point's D regularisers.
   std::vector<GraphNeighbour> BestNeighbours(PointId point, const std::function<bool(PointId)>& eligible = {}) const;
+  // The regularisers among `points` (map indices): each one's BestNeighbours among the others,
+  // each pair once, in the order of the points and then of their neighbours. That order
+  // fixes the order of a solver's residual blocks, and so its floating-point sums.
+  std::vector<GraphPair> PairsAmong(const std::vector<PointId>& points) const;
   // Unpruned edges of the point (kept as a count: asked for every point every frame).
   int GoodEdgeCount(PointId point) const;
   // Fewer than min_good_edges unpruned edges left: the point's deformation is unconstrained.
@@ -97,6 +110,8 @@ class DeformationGraph {
   std::unordered_map<uint64_t, int> edge_index_;  // keyed by the unordered pair
 
   double WeightOf(double max_length) const;
+  template <typename Eligible>
+  void SelectBest(PointId point, const Eligible& eligible, std::vector<GraphNeighbour>* best) const;
   void Remeasure(int index, double length);  // a new observed length: d_min, d_max, b, pruning
   void UpdateRanking(int index);
   static uint64_t PairKey(PointId a, PointId b);

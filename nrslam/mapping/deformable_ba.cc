@@ -5,7 +5,6 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
-#include <set>
 #include <unordered_map>
 
 #include "nrslam/camera/reprojection_cost.h"
@@ -23,26 +22,23 @@ DbaRegularisers WindowRegularisers(const DeformationGraph& graph, const std::vec
   }
   DbaRegularisers regularisers(window.size());
   for (size_t k = 0; k < window.size(); ++k) {
-    const auto seen = [&](PointId id) { return index[k].count(id) > 0; };
     const auto index_next = [&](PointId id) {
       if (k + 1 >= window.size()) return -1;
       const auto found = index[k + 1].find(id);
       return found == index[k + 1].end() ? -1 : static_cast<int>(found->second);
     };
-    std::set<std::pair<PointId, PointId>> done;
-    for (const auto& [id, i] : index[k]) {
-      for (const GraphNeighbour& neighbour : graph.BestNeighbours(id, seen)) {
-        if (!done.insert(std::minmax(id, neighbour.id)).second) continue;
-        DbaPair pair;
-        pair.i = i;
-        pair.j = index[k].at(neighbour.id);
-        pair.rest_length = graph.edge(neighbour.edge).rest_length;
-        pair.weight_b = neighbour.weight;
-        pair.next_i = index_next(id);
-        pair.next_j = index_next(neighbour.id);
-        if (pair.next_i < 0 || pair.next_j < 0) pair.next_i = pair.next_j = -1;
-        regularisers[k].push_back(pair);
-      }
+    std::vector<PointId> ids;
+    for (const auto& entry : index[k]) ids.push_back(entry.first);
+    for (const GraphPair& graph_pair : graph.PairsAmong(ids)) {
+      DbaPair pair;
+      pair.i = index[k].at(ids[graph_pair.i]);
+      pair.j = index[k].at(ids[graph_pair.j]);
+      pair.rest_length = graph.edge(graph_pair.edge).rest_length;
+      pair.weight_b = graph_pair.weight;
+      pair.next_i = index_next(ids[graph_pair.i]);
+      pair.next_j = index_next(ids[graph_pair.j]);
+      if (pair.next_i < 0 || pair.next_j < 0) pair.next_i = pair.next_j = -1;
+      regularisers[k].push_back(pair);
     }
   }
   return regularisers;

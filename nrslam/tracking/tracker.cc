@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
@@ -306,30 +305,22 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
                                                    std::vector<Eigen::Vector3d>* displacements,
                                                    std::vector<bool>* inliers) const {
   const size_t n = observations.size();
-  // Observation index by point id (−1: not observed); a dense table because the graph asks
-  // it for every edge of every observed point.
-  std::vector<int> index(map_->size(), -1);
+  std::vector<PointId> ids(n);
   std::vector<Eigen::Vector3d> points(n);
   for (size_t i = 0; i < n; ++i) {
-    index[static_cast<size_t>(observations[i].id)] = static_cast<int>(i);
+    ids[i] = observations[i].id;
     points[i] = map_->point(observations[i].id).position;
   }
-  // Regularised pairs: each point's best D edges to other tracked points, each pair once.
+  // Regularised pairs: each point's best D edges to other tracked points, each pair once,
+  // lower index first (the orientation is free, but it moves the solver's rounding).
   struct Pair {
     size_t i, j;
     double rest_length, viscous_multiplier;
   };
   std::vector<Pair> pairs;
-  std::set<std::pair<size_t, size_t>> seen;
-  const auto is_tracked = [&](PointId id) { return index[static_cast<size_t>(id)] >= 0; };
-  for (size_t i = 0; i < n; ++i) {
-    for (const GraphNeighbour& neighbour : map_->graph().BestNeighbours(observations[i].id, is_tracked)) {
-      const auto j = static_cast<size_t>(index[static_cast<size_t>(neighbour.id)]);
-      const auto key = std::minmax(i, j);  // a pair of references: j must outlive it
-      if (!seen.insert(key).second) continue;
-      pairs.push_back({key.first, key.second, map_->graph().edge(neighbour.edge).rest_length,
-                       ViscousMultiplier(deformation_, neighbour.weight, map_->scale())});
-    }
+  for (const GraphPair& pair : map_->graph().PairsAmong(ids)) {
+    pairs.push_back({std::min(pair.i, pair.j), std::max(pair.i, pair.j), map_->graph().edge(pair.edge).rest_length,
+                     ViscousMultiplier(deformation_, pair.weight, map_->scale())});
   }
 
   const PoseParams rigid = pose->ToParams();
@@ -489,15 +480,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
       demoted[i] = norms[i] >= fence && norms[i] > 0;
       if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
     }
-    const PositionLookup positions = map_->Positions();
     std::vector<std::optional<Eigen::Vector3d>> optimised(map_->size());
-    std::vector<PointId> demoted_ids;
+    std::vector<PointId> demoted_ids, updated_ids;
     for (size_t i = 0; i < observations.size(); ++i) {
       if (demoted[i]) demoted_ids.push_back(observations[i].id);
       if (!inliers[i] || demoted[i]) continue;
-      map_->graph().UpdatePoint(observations[i].id, positions);
+      updated_ids.push_back(observations[i].id);
       optimised[static_cast<size_t>(observations[i].id)] = displacements[i];
     }
+    map_->graph().UpdatePoints(updated_ids, map_->Positions());
     result.propagated = PropagateMotion(optimised, demoted_ids);
   }
   result.ms_deformation = MillisecondsSince(deformation_start);
