@@ -70,6 +70,41 @@ TEST(DeformationGraph, EachPointUsesItsBestDEdgesByWeight) {
   EXPECT_EQ(wide.BestNeighbours(0).size(), 6u);
 }
 
+// The pairs a solver regularises among a subset of the points: exactly the union of each
+// listed point's best D edges to other listed points, each pair once, in first-use order.
+TEST(DeformationGraph, PairsAmongListedPointsAreTheirBestEdgesEachOnce) {
+  DeformationModelOptions options;
+  options.max_degree_D = 3;
+  DeformationGraph graph(options, 2.0);
+  Positions positions;
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(0.0, 3.0);
+  for (PointId id = 0; id < 30; ++id) positions.at[id] = {coordinate(random), coordinate(random), 0.0};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  const std::vector<PointId> listed = {17, 3, 25, 8, 0, 12, 29, 21, 5, 14};  // not sorted: order is the caller's
+  const auto is_listed = [&](PointId id) { return std::count(listed.begin(), listed.end(), id) > 0; };
+  const auto unordered = [](PointId a, PointId b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+  std::vector<std::pair<PointId, PointId>> expected;  // unordered pairs in order of first use
+  for (const PointId id : listed) {
+    for (const GraphNeighbour& neighbour : graph.BestNeighbours(id, is_listed)) {
+      const auto key = unordered(id, neighbour.id);
+      if (std::find(expected.begin(), expected.end(), key) == expected.end()) expected.push_back(key);
+    }
+  }
+  const std::vector<GraphPair> pairs = graph.PairsAmong(listed);
+  ASSERT_EQ(pairs.size(), expected.size());
+  ASSERT_LT(pairs.size(), listed.size() * 3);  // some pairs were chosen from both ends
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const PointId a = listed[pairs[p].i], b = listed[pairs[p].j];
+    EXPECT_EQ(unordered(a, b), expected[p]);
+    const GraphEdge& edge = graph.edge(pairs[p].edge);
+    EXPECT_EQ(unordered(edge.a, edge.b), expected[p]);
+    EXPECT_EQ(pairs[p].weight, edge.weight);
+  }
+  EXPECT_TRUE(graph.PairsAmong({}).empty());
+  EXPECT_THROW(graph.PairsAmong({1, kNoPoint}), Error);
+}
+
 // Two clusters that separate (the lap-lobes situation): every edge across is pruned, none within.
 TEST(DeformationGraph, PrunesEdgesBetweenSeparatingClusters) {
   DeformationModelOptions options;
