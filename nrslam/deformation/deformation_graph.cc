@@ -101,31 +101,37 @@ void DeformationGraph::ConnectCovisible(const std::vector<PointId>& new_points, 
 
 namespace {
 
-// Position of each id in `points` (−1: not there), as a table indexed by id: the graph asks it
-// for every edge of every point, hundreds per point.
-std::vector<int> PositionsInList(const std::vector<PointId>& points) {
-  PointId largest = -1;
-  for (PointId id : points) largest = std::max(largest, id);
-  std::vector<int> position(static_cast<size_t>(largest + 1), -1);
-  for (size_t k = 0; k < points.size(); ++k) {
-    if (points[k] < 0) throw Error("deformation graph: point ids are map indices, got " + std::to_string(points[k]));
-    position[static_cast<size_t>(points[k])] = static_cast<int>(k);
+// Where each id sits in a list of points, as a table indexed by id: the graph asks it for
+// every edge of every listed point, hundreds per point.
+class ListPositions {
+ public:
+  explicit ListPositions(const std::vector<PointId>& points) {
+    PointId largest = -1;
+    for (PointId id : points) largest = std::max(largest, id);
+    position_.assign(static_cast<size_t>(largest + 1), -1);
+    for (size_t k = 0; k < points.size(); ++k) {
+      if (points[k] < 0) throw Error("deformation graph: point ids are map indices, got " + std::to_string(points[k]));
+      position_[static_cast<size_t>(points[k])] = static_cast<int>(k);
+    }
   }
-  return position;
-}
+  bool Contains(PointId id) const { return static_cast<size_t>(id) < position_.size() && At(id) >= 0; }
+  int At(PointId id) const { return position_[static_cast<size_t>(id)]; }
+
+ private:
+  std::vector<int> position_;  // −1: not listed
+};
 
 }  // namespace
 
 void DeformationGraph::UpdatePoints(const std::vector<PointId>& points, const PositionLookup& position) {
-  const std::vector<int> listed = PositionsInList(points);
-  const auto is_listed = [&](PointId id) { return static_cast<size_t>(id) < listed.size() && listed[static_cast<size_t>(id)] >= 0; };
+  const ListPositions listed(points);
   for (PointId point : points) {
     const auto node = nodes_.find(point);
     if (node == nodes_.end()) continue;
     const auto here = position(point);
     if (!here) continue;
     for (const Incidence& incidence : node->second.edges) {
-      if (incidence.other < point && is_listed(incidence.other)) continue;  // measured from its other end
+      if (incidence.other < point && listed.Contains(incidence.other)) continue;  // measured from its other end
       const auto there = position(incidence.other);
       if (there) Remeasure(incidence.edge, (*here - *there).norm());
     }
@@ -184,15 +190,15 @@ std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
 }
 
 std::vector<GraphPair> DeformationGraph::PairsAmong(const std::vector<PointId>& points) const {
-  const std::vector<int> listed = PositionsInList(points);
-  const auto is_listed = [&](PointId id) { return static_cast<size_t>(id) < listed.size() && listed[static_cast<size_t>(id)] >= 0; };
+  const ListPositions listed(points);
+  const auto is_listed = [&](PointId id) { return listed.Contains(id); };
   std::vector<std::vector<size_t>> chosen(points.size());  // each point's neighbours, at most D
   std::vector<GraphPair> pairs;
   std::vector<GraphNeighbour> best;
   for (size_t i = 0; i < points.size(); ++i) {
     SelectBest(points[i], is_listed, &best);
     for (const GraphNeighbour& neighbour : best) {
-      const auto j = static_cast<size_t>(listed[static_cast<size_t>(neighbour.id)]);
+      const auto j = static_cast<size_t>(listed.At(neighbour.id));
       chosen[i].push_back(j);
       // With a point listed earlier, the pair exists already if that point chose this one.
       if (j < i && std::find(chosen[j].begin(), chosen[j].end(), i) != chosen[j].end()) continue;
