@@ -192,16 +192,21 @@ std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
 std::vector<GraphPair> DeformationGraph::PairsAmong(const std::vector<PointId>& points) const {
   const ListPositions listed(points);
   const auto is_listed = [&](PointId id) { return listed.Contains(id); };
-  std::vector<std::vector<size_t>> chosen(points.size());  // each point's neighbours, at most D
+  // Point i's chosen neighbours (list positions) are chosen[i·D, i·D + chosen_count[i]):
+  // one allocation per call rather than one per point, as this runs every frame.
+  const auto degree = static_cast<size_t>(options_.max_degree_D);
+  std::vector<size_t> chosen(points.size() * degree), chosen_count(points.size(), 0);
   std::vector<GraphPair> pairs;
   std::vector<GraphNeighbour> best;
   for (size_t i = 0; i < points.size(); ++i) {
     SelectBest(points[i], is_listed, &best);
     for (const GraphNeighbour& neighbour : best) {
       const auto j = static_cast<size_t>(listed.At(neighbour.id));
-      chosen[i].push_back(j);
+      chosen[i * degree + chosen_count[i]++] = j;
       // With a point listed earlier, the pair exists already if that point chose this one.
-      if (j < i && std::find(chosen[j].begin(), chosen[j].end(), i) != chosen[j].end()) continue;
+      const size_t* j_first = chosen.data() + j * degree;
+      const size_t* j_end = j_first + chosen_count[j];
+      if (j < i && std::find(j_first, j_end, i) != j_end) continue;
       pairs.push_back({i, j, neighbour.edge, neighbour.weight});
     }
   }

@@ -38,9 +38,10 @@ class ElasticCost final : public ceres::SizedCostFunction<1, 3, 3> {
     // The epsilon keeps the derivative finite for coincident points (never met in practice).
     const double length = std::sqrt(difference.squaredNorm() + 1e-24);
     residual[0] = multiplier_ * (length - rest_length_);
+    if (jacobians == nullptr) return true;  // Ceres asks for residuals alone when it tries a step
     const Eigen::Vector3d gradient = (multiplier_ / length) * difference;  // ∂r/∂p_i = −∂r/∂p_j
-    if (jacobians != nullptr && jacobians[0] != nullptr) Eigen::Map<Eigen::Vector3d>{jacobians[0]} = gradient;
-    if (jacobians != nullptr && jacobians[1] != nullptr) Eigen::Map<Eigen::Vector3d>{jacobians[1]} = -gradient;
+    if (jacobians[0] != nullptr) Eigen::Map<Eigen::Vector3d>{jacobians[0]} = gradient;
+    if (jacobians[1] != nullptr) Eigen::Map<Eigen::Vector3d>{jacobians[1]} = -gradient;
     return true;
   }
   static ceres::CostFunction* Create(const Eigen::Vector3d& base_i, const Eigen::Vector3d& base_j,

@@ -28,11 +28,15 @@ DbaRegularisers WindowRegularisers(const DeformationGraph& graph, const std::vec
       return found == index[k + 1].end() ? -1 : static_cast<int>(found->second);
     };
     std::vector<PointId> ids;
-    for (const auto& entry : index[k]) ids.push_back(entry.first);
+    std::vector<size_t> keyframe_index;  // of ids[n] in window[k]
+    for (const auto& [id, i] : index[k]) {
+      ids.push_back(id);
+      keyframe_index.push_back(i);
+    }
     for (const GraphPair& graph_pair : graph.PairsAmong(ids)) {
       DbaPair pair;
-      pair.i = index[k].at(ids[graph_pair.i]);
-      pair.j = index[k].at(ids[graph_pair.j]);
+      pair.i = keyframe_index[graph_pair.i];
+      pair.j = keyframe_index[graph_pair.j];
       pair.rest_length = graph.edge(graph_pair.edge).rest_length;
       pair.weight_b = graph_pair.weight;
       pair.next_i = index_next(ids[graph_pair.i]);
