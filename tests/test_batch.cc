@@ -222,6 +222,47 @@ TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {
   EXPECT_NE(table.str().find("over the 2 sequence(s)"), std::string::npos) << table.str();
 }
 
+// Known answers for the paired counts: k = 2 against k's default 1.1, each run against the run
+// of the same sequence and the same D. a is better at both D, b the same (within 0.0005 mm) at
+// both, c worse at D = 3 and better at D = 5 (paired with D = 3 it would be worse twice), and d,
+// lost at k = 2, counts nowhere. D's default (10) is not swept, so D's values are not paired.
+TEST(Results, SweepSummaryCountsRunsBetterAndWorseThanTheDefault) {
+  const std::map<std::string, std::map<std::string, double>> rmse = {
+      {"a", {{"1.1 3", 1.0}, {"1.1 5", 1.0}, {"2 3", 0.5}, {"2 5", 0.5}}},
+      {"b", {{"1.1 3", 2.0}, {"1.1 5", 2.0}, {"2 3", 2.0003}, {"2 5", 1.9998}}},
+      {"c", {{"1.1 3", 1.0}, {"1.1 5", 5.0}, {"2 3", 3.0}, {"2 5", 4.0}}},
+      {"d", {{"1.1 3", 1.0}, {"1.1 5", 1.0}, {"2 3", 9.0}, {"2 5", 9.0}}}};
+  std::vector<RunResult> results;
+  for (const auto& [sequence, cells] : rmse) {
+    for (const auto& [point, value] : cells) {
+      const std::string k = point.substr(0, point.find(' ')), d = point.substr(point.find(' ') + 1);
+      RunResult r;
+      r.sequence = sequence;
+      r.point = {"deformation.k=" + k, "deformation.max_degree_D=" + d};
+      r.label = "k=" + k + " D=" + d;
+      r.status = sequence == "d" && k == "2" ? "lost" : "ok";
+      r.frames_evaluated = 100;
+      r.rmse_mm = value;
+      results.push_back(r);
+    }
+  }
+  const std::vector<SweepValueSummary> values = SummariseSweep(results);
+  ASSERT_EQ(values.size(), 4u);
+  EXPECT_EQ(values[0].value, "1.1");
+  EXPECT_TRUE(values[0].is_default);
+  EXPECT_FALSE(values[0].paired);
+  EXPECT_EQ(values[1].value, "2");
+  ASSERT_TRUE(values[1].paired);
+  EXPECT_EQ(values[1].better, 3);
+  EXPECT_EQ(values[1].same, 2);
+  EXPECT_EQ(values[1].worse, 1);
+  for (size_t i : {2u, 3u}) EXPECT_FALSE(values[i].paired || values[i].is_default) << values[i].value;
+  std::stringstream table;
+  PrintResults(results, table);
+  EXPECT_NE(table.str().find("3 / 2 / 1"), std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("(default)"), std::string::npos) << table.str();
+}
+
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   const auto folder = UniqueTempFolder("batch_broken");
   // A sequence folder with an incomplete sequence.json, between two good simulated ones (eight

@@ -143,10 +143,20 @@ std::string SweepSection(const std::vector<RunResult>& results) {
       }
     }
   }
-  if (curves.empty()) return "";
+  const std::vector<SweepValueSummary> summaries = SummariseSweep(results);
+  if (summaries.empty()) return "";
   static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"};
   std::ostringstream html;
-  html << "<section><h2>Sweeps</h2><p>RMSE of the runs that tracked every frame against each swept option, "
+  html << "<section><h2>Sweeps</h2><p>Per swept value, over the sequences tracked to the end at every point; "
+          "each run is also paired with the run of the same sequence at the option's default.</p><table><tr>";
+  for (const std::string& column : SweepSummaryHeader()) html << "<th>" << EscapeXml(column) << "</th>";
+  html << "</tr>\n";
+  for (const SweepValueSummary& summary : summaries) {
+    html << "<tr>";
+    for (const std::string& cell : SweepSummaryCells(summary)) html << "<td>" << EscapeXml(cell) << "</td>";
+    html << "</tr>\n";
+  }
+  html << "</table><p>RMSE of the runs that tracked every frame against each swept option, "
           "per sequence; with several options swept, each point is the mean over the others' values.</p>"
           "<div class=\"plots\">";
   for (const auto& [option, sequences] : curves) {

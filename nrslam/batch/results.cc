@@ -1,11 +1,15 @@
 #include "nrslam/batch/results.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <numeric>
 #include <sstream>
 
+#include "nrslam/system/system_options.h"
+#include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/text_table.h"
 
@@ -45,6 +49,25 @@ std::map<std::string, bool> CompleteSequences(const std::vector<RunResult>& resu
     complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
   }
   return complete;
+}
+
+// Whether "path=value" sets nrslam_run's default (parsed as the option's type, so "1.10" is 1.1).
+bool IsDefaultAssignment(const std::string& assignment) {
+  const Json defaults = SystemOptions{};
+  Json probe = defaults;
+  try {
+    ApplyAssignment(probe, assignment);
+  } catch (const Error&) {
+    return false;  // not an option of this build (e.g. results from an older one)
+  }
+  return probe == defaults;
+}
+
+// A run's sweep point with `option`'s assignment replaced, as a lookup key with the sequence.
+std::string PairKey(const RunResult& run, const std::string& option, const std::string& assignment) {
+  std::string key = run.sequence;
+  for (const std::string& a : run.point) key += '\n' + (a.compare(0, option.size() + 1, option + "=") == 0 ? assignment : a);
+  return key;
 }
 
 }  // namespace
@@ -159,15 +182,25 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   for (const auto& [name, ok] : CompleteSequences(results)) sequences += ok;
   out << "\nPer swept value, over the " << sequences << " sequence(s) tracked to the end at every point"
       << " (not to end: that value's runs, over all sequences, lost or failed):\n";
-  TextTable summary({"option", "value", "mean RMSE mm", "median mm", "mean ATE mm", "runs", "not to end"});
-  for (const SweepValueSummary& v : values) {
-    const bool any = v.runs > 0;
-    summary.AddRow({v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-",
-                    any ? FormatFixed(v.median_rmse_mm, 3) : "-",
-                    any && v.mean_ate_mm >= 0 ? FormatFixed(v.mean_ate_mm, 3) : "-", std::to_string(v.runs),
-                    std::to_string(v.short_runs)});
-  }
+  TextTable summary(SweepSummaryHeader());
+  for (const SweepValueSummary& v : values) summary.AddRow(SweepSummaryCells(v));
   summary.Print(out);
+}
+
+std::vector<std::string> SweepSummaryHeader() {
+  return {"option", "value", "mean RMSE mm", "median mm", "mean ATE mm", "runs", "not to end",
+          "vs default: better / same / worse"};
+}
+
+std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
+  const bool any = v.runs > 0;
+  const std::string paired = v.is_default ? "(default)"
+                             : v.paired   ? std::to_string(v.better) + " / " + std::to_string(v.same) + " / " +
+                                              std::to_string(v.worse)
+                                          : "-";
+  return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
+          any && v.mean_ate_mm >= 0 ? FormatFixed(v.mean_ate_mm, 3) : "-", std::to_string(v.runs),
+          std::to_string(v.short_runs), paired};
 }
 
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results) {
@@ -197,6 +230,18 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
   const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
   std::vector<SweepValueSummary> summaries;
   for (const auto& [option, values] : by_value) {
+    std::string default_value;
+    for (const auto& [value, cell] : values) {
+      if (IsDefaultAssignment(option + "=" + value)) default_value = value;
+    }
+    const auto has = [](const RunResult& r, const std::string& assignment) {
+      return std::find(r.point.begin(), r.point.end(), assignment) != r.point.end();
+    };
+    const std::string default_assignment = option + "=" + default_value;
+    std::map<std::string, double> at_default;  // PairKey → RMSE of the run at the default
+    for (const RunResult& r : results) {
+      if (complete.at(r.sequence) && has(r, default_assignment)) at_default[PairKey(r, option, default_assignment)] = r.rmse_mm;
+    }
     for (const auto& [value, cell] : values) {
       SweepValueSummary summary{option, value, static_cast<int>(cell.rmse.size())};
       summary.short_runs = cell.short_runs;
@@ -204,6 +249,15 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
         summary.mean_rmse_mm = mean(cell.rmse);
         summary.median_rmse_mm = Median(cell.rmse);
         if (cell.ate_everywhere) summary.mean_ate_mm = mean(cell.ate);
+      }
+      summary.is_default = value == default_value;
+      summary.paired = !default_value.empty() && !summary.is_default;
+      for (const RunResult& r : results) {
+        if (!summary.paired || !complete.at(r.sequence) || !has(r, option + "=" + value)) continue;
+        const auto partner = at_default.find(PairKey(r, option, default_assignment));
+        if (partner == at_default.end()) continue;
+        const double change = r.rmse_mm - partner->second;
+        (std::abs(change) < 5e-4 ? summary.same : change < 0 ? summary.better : summary.worse) += 1;
       }
       summaries.push_back(summary);
     }

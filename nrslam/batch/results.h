@@ -51,9 +51,19 @@ struct SweepValueSummary {
   double mean_rmse_mm = 0, median_rmse_mm = 0;
   double mean_ate_mm = -1;       // negative: one of those runs has no trajectory error
   int short_runs = 0;            // runs at this value, over every sequence, failed or lost before the end
+  // Paired with the option's default (nrslam_run's, when it is one of the swept values): each
+  // run against the run of the same sequence and other swept values at the default, over the
+  // same sequences as the means. Single runs are chaotic, so how many moved which way says
+  // more than a difference of means. "Same" is equal to the printed 0.001 mm.
+  bool is_default = false;
+  bool paired = false;           // the default is among the swept values and this is not it
+  int better = 0, same = 0, worse = 0;
 };
 // Per option, values in numeric order when they are numbers ("5" before "10"), else as text.
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results);
+// The columns of that summary as the text table and the HTML report show it, and one row's cells.
+std::vector<std::string> SweepSummaryHeader();
+std::vector<std::string> SweepSummaryCells(const SweepValueSummary& summary);
 
 // The table a person reads: sequence, [sweep point], status, init frame, tracked/total,
 // RMSE mean and median (mm), trajectory error (mm), fps. With sweeps, also SummariseSweep's table.
