@@ -181,6 +181,18 @@ TEST(Results, RunsWithoutGroundTruthShowNoRmse) {
   EXPECT_EQ(ResultsFromJson(old)[0].frames_evaluated, 42);
 }
 
+// One run of a (k, D) sweep grid, evaluated on 100 frames.
+RunResult GridRun(const std::string& sequence, const std::string& k, const std::string& d, bool lost, double rmse_mm) {
+  RunResult r;
+  r.sequence = sequence;
+  r.point = {"deformation.k=" + k, "deformation.max_degree_D=" + d};
+  r.label = "k=" + k + " D=" + d;
+  r.status = lost ? "lost" : "ok";
+  r.frames_evaluated = 100;
+  r.rmse_mm = rmse_mm;
+  return r;
+}
+
 // Known answers for a 2 × 2 grid (k, D) over three sequences, one of which is lost at k = 10:
 // only the two sequences complete at every point count, each value sees 2 points × 2 sequences.
 TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {
@@ -188,13 +200,8 @@ TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {
   for (const std::string sequence : {"a", "b", "c"}) {
     for (const std::string k : {"10", "2"}) {  // "2" comes first: numeric order
       for (const std::string d : {"3", "5"}) {
-        RunResult r;
-        r.sequence = sequence;
-        r.point = {"deformation.k=" + k, "deformation.max_degree_D=" + d};
-        r.label = "k=" + k + " D=" + d;
-        r.status = sequence == "c" && k == "10" ? "lost" : "ok";
-        r.frames_evaluated = 100;
-        r.rmse_mm = (sequence == "a" ? 1.0 : 2.0) * std::stod(k) + std::stod(d) / 10;  // c equals b
+        const double rmse = (sequence == "a" ? 1.0 : 2.0) * std::stod(k) + std::stod(d) / 10;  // c equals b
+        RunResult r = GridRun(sequence, k, d, sequence == "c" && k == "10", rmse);
         r.ate_mm = sequence == "b" && d == "5" ? -1 : r.rmse_mm / 2;
         results.push_back(r);
       }
@@ -236,14 +243,7 @@ TEST(Results, SweepSummaryCountsRunsBetterAndWorseThanTheDefault) {
   for (const auto& [sequence, cells] : rmse) {
     for (const auto& [point, value] : cells) {
       const std::string k = point.substr(0, point.find(' ')), d = point.substr(point.find(' ') + 1);
-      RunResult r;
-      r.sequence = sequence;
-      r.point = {"deformation.k=" + k, "deformation.max_degree_D=" + d};
-      r.label = "k=" + k + " D=" + d;
-      r.status = sequence == "d" && k == "2" ? "lost" : "ok";
-      r.frames_evaluated = 100;
-      r.rmse_mm = value;
-      results.push_back(r);
+      results.push_back(GridRun(sequence, k, d, sequence == "d" && k == "2", value));
     }
   }
   const std::vector<SweepValueSummary> values = SummariseSweep(results);
