@@ -156,7 +156,9 @@ std::string SweepSection(const std::vector<RunResult>& results) {
     for (const std::string& cell : SweepSummaryCells(summary)) html << "<td>" << EscapeXml(cell) << "</td>";
     html << "</tr>\n";
   }
-  html << "</table><p>RMSE of the runs that tracked every frame against each swept option, "
+  html << "</table>\n";
+  if (curves.empty()) return html.str() + "</section>\n";  // no numeric values to plot against
+  html << "<p>RMSE of the runs that tracked every frame against each swept option, "
           "per sequence; with several options swept, each point is the mean over the others' values.</p>"
           "<div class=\"plots\">";
   for (const auto& [option, sequences] : curves) {

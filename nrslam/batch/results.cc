@@ -51,9 +51,9 @@ std::map<std::string, bool> CompleteSequences(const std::vector<RunResult>& resu
   return complete;
 }
 
-// Whether "path=value" sets nrslam_run's default (parsed as the option's type, so "1.10" is 1.1).
-bool IsDefaultAssignment(const std::string& assignment) {
-  const Json defaults = SystemOptions{};
+// Whether "path=value" sets the value `defaults` (nrslam_run's options, as JSON) has: parsed as
+// the option's type, so "1.10" is 1.1.
+bool IsDefaultAssignment(const Json& defaults, const std::string& assignment) {
   Json probe = defaults;
   try {
     ApplyAssignment(probe, assignment);
@@ -228,15 +228,16 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
     }
   }
   const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
+  const auto has = [](const RunResult& r, const std::string& assignment) {
+    return std::find(r.point.begin(), r.point.end(), assignment) != r.point.end();
+  };
+  const Json defaults = SystemOptions{};
   std::vector<SweepValueSummary> summaries;
   for (const auto& [option, values] : by_value) {
     std::string default_value;
     for (const auto& [value, cell] : values) {
-      if (IsDefaultAssignment(option + "=" + value)) default_value = value;
+      if (IsDefaultAssignment(defaults, option + "=" + value)) default_value = value;
     }
-    const auto has = [](const RunResult& r, const std::string& assignment) {
-      return std::find(r.point.begin(), r.point.end(), assignment) != r.point.end();
-    };
     const std::string default_assignment = option + "=" + default_value;
     std::map<std::string, double> at_default;  // PairKey → RMSE of the run at the default
     for (const RunResult& r : results) {
@@ -252,8 +253,9 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       }
       summary.is_default = value == default_value;
       summary.paired = !default_value.empty() && !summary.is_default;
+      const std::string assignment = option + "=" + value;
       for (const RunResult& r : results) {
-        if (!summary.paired || !complete.at(r.sequence) || !has(r, option + "=" + value)) continue;
+        if (!summary.paired || !complete.at(r.sequence) || !has(r, assignment)) continue;
         const auto partner = at_default.find(PairKey(r, option, default_assignment));
         if (partner == at_default.end()) continue;
         const double change = r.rmse_mm - partner->second;
