@@ -11,6 +11,7 @@
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
+#include "nrslam/batch/results_diff.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
 #include "temp_folder.h"
@@ -253,14 +254,62 @@ TEST(Results, SweepSummaryCountsRunsBetterAndWorseThanTheDefault) {
   EXPECT_FALSE(values[0].paired);
   EXPECT_EQ(values[1].value, "2");
   ASSERT_TRUE(values[1].paired);
-  EXPECT_EQ(values[1].better, 3);
-  EXPECT_EQ(values[1].same, 2);
-  EXPECT_EQ(values[1].worse, 1);
+  EXPECT_EQ(values[1].against_default.better, 3);
+  EXPECT_EQ(values[1].against_default.same, 2);
+  EXPECT_EQ(values[1].against_default.worse, 1);
   for (size_t i : {2u, 3u}) EXPECT_FALSE(values[i].paired || values[i].is_default) << values[i].value;
   std::stringstream table;
   PrintResults(results, table);
   EXPECT_NE(table.str().find("3 / 2 / 1"), std::string::npos) << table.str();
   EXPECT_NE(table.str().find("(default)"), std::string::npos) << table.str();
+}
+
+// Known answers for two evaluations set side by side. Runs pair by sequence and sweep point:
+// a at D = 3 is the same (within 0.0005 mm), a at D = 5 better, b worse; paired by sequence
+// alone, a's two runs would cross and count differently. d is lost in B and e failed in A, so
+// neither counts; c and f are each in one evaluation only.
+TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
+  const auto run = [](const std::string& sequence, const std::string& d, double rmse_mm, double ate_mm) {
+    RunResult r = GridRun(sequence, "2", d, false, rmse_mm);
+    r.ate_mm = ate_mm;
+    return r;
+  };
+  RunResult failed = run("e", "3", 0, -1);
+  failed.status = "failed";
+  RunResult lost = run("d", "3", 0.1, 0.1);
+  lost.status = "lost";
+  const std::vector<RunResult> a = {run("a", "3", 1.0, 0.5), run("a", "5", 3.0, 1.5), run("b", "3", 2.0, 1.0),
+                                    run("c", "3", 4.0, 2.0), run("d", "3", 1.0, 0.5),  failed};
+  const std::vector<RunResult> b = {run("a", "5", 2.0, 1.0), run("a", "3", 1.0003, 0.4), run("b", "3", 2.5, 1.2),
+                                    lost, run("e", "3", 1.0, 0.5), run("f", "3", 1.0, 0.5)};
+  const ResultsDiff diff = DiffResults(a, b);
+  ASSERT_EQ(diff.rows.size(), 7u);
+  EXPECT_EQ(diff.rows.front().key, "a [k=2 D=3]");  // A's order first ...
+  EXPECT_EQ(diff.rows.back().key, "f [k=2 D=3]");   // ... then what only B has
+  EXPECT_EQ(diff.comparable, 3);
+  EXPECT_DOUBLE_EQ(diff.mean_rmse_a_mm, 2.0);
+  EXPECT_NEAR(diff.mean_rmse_b_mm, (1.0003 + 2.0 + 2.5) / 3, 1e-12);
+  EXPECT_DOUBLE_EQ(diff.median_rmse_a_mm, 2.0);
+  EXPECT_DOUBLE_EQ(diff.median_rmse_b_mm, 2.0);
+  EXPECT_DOUBLE_EQ(diff.mean_ate_a_mm, 1.0);
+  EXPECT_NEAR(diff.mean_ate_b_mm, 2.6 / 3, 1e-12);
+  EXPECT_EQ(diff.b_against_a.better, 1);
+  EXPECT_EQ(diff.b_against_a.same, 1);
+  EXPECT_EQ(diff.b_against_a.worse, 1);
+  EXPECT_EQ(diff.short_only_a, 1);
+  EXPECT_EQ(diff.short_only_b, 1);
+  EXPECT_EQ(diff.short_both, 0);
+  EXPECT_EQ(diff.only_in_a, 1);
+  EXPECT_EQ(diff.only_in_b, 1);
+  std::stringstream table;
+  PrintDiff(diff, "before", "after", table);
+  for (const char* expected : {"1 / 1 / 1", "absent", "FAILED", "-1.000", "0.500"}) {
+    EXPECT_NE(table.str().find(expected), std::string::npos) << expected << "\n" << table.str();
+  }
+  // A run without a trajectory error leaves the mean ATE out rather than averaging a gap.
+  std::vector<RunResult> no_ate = b;
+  no_ate[2].ate_mm = -1;
+  EXPECT_LT(DiffResults(a, no_ate).mean_ate_b_mm, 0);
 }
 
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {

@@ -2,7 +2,8 @@
 // with optional parameter sweeps, prints the results table, writes results.json/.csv, and
 // checks or writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
 // result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere); `nrslam_eval
-// compare RUN_A RUN_B` scores two runs of one sequence on the points both report.
+// compare RUN_A RUN_B` scores two runs of one sequence on the points both report; `nrslam_eval
+// diff EVAL_A EVAL_B` sets two evaluations of the same runs side by side, run for run.
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
+#include "nrslam/batch/results_diff.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
@@ -102,10 +104,19 @@ int main(int argc, char** argv) {
                                                     "rigid from the same depth map) on the points both report");
   std::vector<std::string> compared;
   compare->add_option("runs", compared, "two run folders")->required()->expected(2);
+  CLI::App* diff = app.add_subcommand("diff", "two evaluations of the same runs (e.g. before and after a change of "
+                                              "code) side by side, run for run");
+  std::vector<std::string> diffed;
+  diff->add_option("evaluations", diffed, "two result folders (each with results.json)")->required()->expected(2);
   CLI11_PARSE(app, argc, argv);
 
   try {
     if (compare->parsed()) return Compare(compared[0], compared[1]);
+    if (diff->parsed()) {
+      const nrslam::ResultsDiff result = nrslam::DiffResults(nrslam::ReadResults(diffed[0]), nrslam::ReadResults(diffed[1]));
+      nrslam::PrintDiff(result, diffed[0], diffed[1], std::cout);
+      return 0;
+    }
     const nrslam::Programs programs = SiblingPrograms();
     std::vector<nrslam::Sweep> grid;
     for (const std::string& sweep : sweeps) grid.push_back(nrslam::ParseSweep(sweep));

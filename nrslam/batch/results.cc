@@ -16,10 +16,6 @@
 namespace nrslam {
 namespace {
 
-std::string Key(const RunResult& result) {
-  return result.label.empty() ? result.sequence : result.sequence + " [" + result.label + "]";
-}
-
 std::string CsvField(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
   std::string quoted = "\"";
@@ -71,6 +67,19 @@ std::string PairKey(const RunResult& run, const std::string& option, const std::
 }
 
 }  // namespace
+
+std::string RunKey(const RunResult& result) {
+  return result.label.empty() ? result.sequence : result.sequence + " [" + result.label + "]";
+}
+
+void RmseChangeCounts::Add(double reference_mm, double rmse_mm) {
+  const double change = rmse_mm - reference_mm;
+  ++(std::abs(change) < 5e-4 ? same : change < 0 ? better : worse);
+}
+
+std::string RmseChangeCounts::ToString() const {
+  return std::to_string(better) + " / " + std::to_string(same) + " / " + std::to_string(worse);
+}
 
 std::string RmseCell(const RunResult& result, double rmse_mm) {
   return result.evaluated() ? FormatFixed(rmse_mm, 3) : "no GT";
@@ -174,7 +183,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   }
   table.Print(out);
   for (const RunResult& r : results) {
-    if (r.status == "failed") out << "FAILED " << Key(r) << ": " << r.error << '\n';
+    if (r.status == "failed") out << "FAILED " << RunKey(r) << ": " << r.error << '\n';
   }
   if (!swept) return;
   const std::vector<SweepValueSummary> values = SummariseSweep(results);
@@ -194,10 +203,7 @@ std::vector<std::string> SweepSummaryHeader() {
 
 std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const bool any = v.runs > 0;
-  const std::string paired = v.is_default ? "(default)"
-                             : v.paired   ? std::to_string(v.better) + " / " + std::to_string(v.same) + " / " +
-                                              std::to_string(v.worse)
-                                          : "-";
+  const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
           any && v.mean_ate_mm >= 0 ? FormatFixed(v.mean_ate_mm, 3) : "-", std::to_string(v.runs),
           std::to_string(v.short_runs), paired};
@@ -244,7 +250,10 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       if (complete.at(r.sequence) && has(r, default_assignment)) at_default[PairKey(r, option, default_assignment)] = r.rmse_mm;
     }
     for (const auto& [value, cell] : values) {
-      SweepValueSummary summary{option, value, static_cast<int>(cell.rmse.size())};
+      SweepValueSummary summary;
+      summary.option = option;
+      summary.value = value;
+      summary.runs = static_cast<int>(cell.rmse.size());
       summary.short_runs = cell.short_runs;
       if (!cell.rmse.empty()) {
         summary.mean_rmse_mm = mean(cell.rmse);
@@ -258,8 +267,7 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
         if (!summary.paired || !complete.at(r.sequence) || !has(r, assignment)) continue;
         const auto partner = at_default.find(PairKey(r, option, default_assignment));
         if (partner == at_default.end()) continue;
-        const double change = r.rmse_mm - partner->second;
-        (std::abs(change) < 5e-4 ? summary.same : change < 0 ? summary.better : summary.worse) += 1;
+        summary.against_default.Add(partner->second, r.rmse_mm);
       }
       summaries.push_back(summary);
     }
@@ -271,7 +279,7 @@ Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance
   Json runs = Json::object();
   for (const RunResult& r : results) {
     if (r.status == "failed") continue;
-    runs[Key(r)] = {{"rmse_mm", r.rmse_mm}, {"frames_tracked", r.frames_tracked}};
+    runs[RunKey(r)] = {{"rmse_mm", r.rmse_mm}, {"frames_tracked", r.frames_tracked}};
   }
   return {{"tolerance",
            {{"rmse_relative", tolerance.rmse_relative},
@@ -293,7 +301,7 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
     throw Error(std::string("baseline is malformed (needs \"tolerance\" and \"runs\"): ") + e.what());
   }
   std::map<std::string, const RunResult*> by_key;
-  for (const RunResult& r : results) by_key[Key(r)] = &r;
+  for (const RunResult& r : results) by_key[RunKey(r)] = &r;
   BaselineCheck check;
   TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
   for (const auto& [key, expected] : runs.items()) {

@@ -26,6 +26,16 @@ struct RunResult {
   bool evaluated() const { return frames_evaluated > 0; }
 };
 
+// How tables and baselines name a run: "sequence", or "sequence [sweep point]".
+std::string RunKey(const RunResult& result);
+// Paired runs counted by how a run's RMSE compares with its partner's (the reference):
+// "same" when equal to the printed 0.001 mm.
+struct RmseChangeCounts {
+  int better = 0, same = 0, worse = 0;
+  void Add(double reference_mm, double rmse_mm);
+  std::string ToString() const;  // "better / same / worse"
+};
+
 // An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
 std::string RmseCell(const RunResult& result, double rmse_mm);
 // The trajectory error as a table shows it: "-" when there was none.
@@ -57,7 +67,7 @@ struct SweepValueSummary {
   // more than a difference of means. "Same" is equal to the printed 0.001 mm.
   bool is_default = false;
   bool paired = false;           // the default is among the swept values and this is not it
-  int better = 0, same = 0, worse = 0;
+  RmseChangeCounts against_default;
 };
 // Per option, values in numeric order when they are numbers ("5" before "10"), else as text.
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results);

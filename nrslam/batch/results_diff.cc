@@ -1,0 +1,107 @@
+#include "nrslam/batch/results_diff.h"
+
+#include <map>
+#include <numeric>
+
+#include "nrslam/util/median.h"
+#include "nrslam/util/text_table.h"
+
+namespace nrslam {
+namespace {
+
+bool Complete(const RunResult& run) { return run.status == "ok" && run.evaluated(); }
+
+double Mean(const std::vector<double>& values) {
+  return std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+}
+
+// RMSE and frames of one side of a row, as the table shows them.
+std::vector<std::string> SideCells(const std::optional<RunResult>& run) {
+  if (!run) return {"absent", "-", "-"};
+  if (run->status == "failed") return {"FAILED", "-", "-"};
+  return {RmseCell(*run, run->rmse_mm), std::to_string(run->frames_tracked) + "/" + std::to_string(run->frames_total),
+          AteCell(*run)};
+}
+
+}  // namespace
+
+bool ResultsDiff::Row::comparable() const { return a && b && Complete(*a) && Complete(*b); }
+
+ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunResult>& b) {
+  ResultsDiff diff;
+  std::map<std::string, size_t> row_of;
+  for (const RunResult& run : a) {
+    row_of[RunKey(run)] = diff.rows.size();
+    diff.rows.push_back({RunKey(run), run, std::nullopt});
+  }
+  for (const RunResult& run : b) {
+    const auto found = row_of.find(RunKey(run));
+    if (found != row_of.end()) {
+      diff.rows[found->second].b = run;
+    } else {
+      diff.rows.push_back({RunKey(run), std::nullopt, run});
+    }
+  }
+  std::vector<double> rmse_a, rmse_b;
+  bool ate_a = true, ate_b = true;
+  double ate_sum_a = 0, ate_sum_b = 0;
+  for (const ResultsDiff::Row& row : diff.rows) {
+    if (!row.a || !row.b) {
+      ++(row.a ? diff.only_in_a : diff.only_in_b);
+      continue;
+    }
+    if (!row.comparable()) {
+      const bool a_short = !Complete(*row.a), b_short = !Complete(*row.b);
+      ++(a_short && b_short ? diff.short_both : a_short ? diff.short_only_a : diff.short_only_b);
+      continue;
+    }
+    rmse_a.push_back(row.a->rmse_mm);
+    rmse_b.push_back(row.b->rmse_mm);
+    ate_a &= row.a->ate_mm >= 0;
+    ate_b &= row.b->ate_mm >= 0;
+    ate_sum_a += row.a->ate_mm;
+    ate_sum_b += row.b->ate_mm;
+    diff.b_against_a.Add(row.a->rmse_mm, row.b->rmse_mm);
+  }
+  diff.comparable = static_cast<int>(rmse_a.size());
+  if (diff.comparable > 0) {
+    diff.mean_rmse_a_mm = Mean(rmse_a);
+    diff.mean_rmse_b_mm = Mean(rmse_b);
+    diff.median_rmse_a_mm = Median(rmse_a);
+    diff.median_rmse_b_mm = Median(rmse_b);
+    if (ate_a) diff.mean_ate_a_mm = ate_sum_a / diff.comparable;
+    if (ate_b) diff.mean_ate_b_mm = ate_sum_b / diff.comparable;
+  }
+  return diff;
+}
+
+void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::string& name_b, std::ostream& out) {
+  out << "A: " << name_a << "\nB: " << name_b << "\n\n";
+  TextTable table({"run", "A RMSE mm", "A tracked", "A ATE mm", "B RMSE mm", "B tracked", "B ATE mm", "B - A mm"});
+  for (const ResultsDiff::Row& row : diff.rows) {
+    std::vector<std::string> cells = {row.key};
+    for (const std::optional<RunResult>* side : {&row.a, &row.b}) {
+      const std::vector<std::string> side_cells = SideCells(*side);
+      cells.insert(cells.end(), side_cells.begin(), side_cells.end());
+    }
+    cells.push_back(row.comparable() ? FormatFixed(row.b->rmse_mm - row.a->rmse_mm, 3) : "-");
+    table.AddRow(cells);
+  }
+  table.Print(out);
+  out << "\nOver the " << diff.comparable << " run(s) tracked to the end with ground truth in both:\n";
+  if (diff.comparable > 0) {
+    TextTable summary({"evaluation", "mean RMSE mm", "median mm", "mean ATE mm"});
+    const auto ate = [](double mm) { return mm >= 0 ? FormatFixed(mm, 3) : std::string("-"); };
+    summary.AddRow({"A", FormatFixed(diff.mean_rmse_a_mm, 3), FormatFixed(diff.median_rmse_a_mm, 3), ate(diff.mean_ate_a_mm)});
+    summary.AddRow({"B", FormatFixed(diff.mean_rmse_b_mm, 3), FormatFixed(diff.median_rmse_b_mm, 3), ate(diff.mean_ate_b_mm)});
+    summary.Print(out);
+    out << "B against A, run for run (better / same / worse): " << diff.b_against_a.ToString() << '\n';
+  }
+  out << "Not tracked to the end (lost or failed): in A only " << diff.short_only_a << ", in B only "
+      << diff.short_only_b << ", in both " << diff.short_both << '\n';
+  if (diff.only_in_a + diff.only_in_b > 0) {
+    out << "Runs in one evaluation only: " << diff.only_in_a << " in A, " << diff.only_in_b << " in B\n";
+  }
+}
+
+}  // namespace nrslam

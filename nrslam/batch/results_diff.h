@@ -1,0 +1,38 @@
+// batch: two evaluations of the same runs side by side, run for run: before and after a change
+// of code (which a sweep cannot vary), or the same options on two machines. Runs pair by
+// sequence and sweep point.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "nrslam/batch/results.h"
+
+namespace nrslam {
+
+struct ResultsDiff {
+  struct Row {
+    std::string key;                 // RunKey
+    std::optional<RunResult> a, b;   // absent: the run is not in that evaluation
+    // Tracked to the end with ground truth in both, so the two RMSEs compare like with like.
+    bool comparable() const;
+  };
+  std::vector<Row> rows;             // A's runs in A's order, then B's runs A lacks
+  // Over the comparable rows only (single runs are chaotic: the counts say more than the means).
+  int comparable = 0;
+  double mean_rmse_a_mm = 0, mean_rmse_b_mm = 0, median_rmse_a_mm = 0, median_rmse_b_mm = 0;
+  double mean_ate_a_mm = -1, mean_ate_b_mm = -1;  // negative: some comparable run has none
+  RmseChangeCounts b_against_a;
+  // Runs in both that one evaluation did not track to the end (lost or failed).
+  int short_only_a = 0, short_only_b = 0, short_both = 0;
+  int only_in_a = 0, only_in_b = 0;
+};
+
+ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunResult>& b);
+
+// The per-run table and the summary, naming the evaluations `name_a` and `name_b`.
+void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::string& name_b, std::ostream& out);
+
+}  // namespace nrslam
