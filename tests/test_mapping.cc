@@ -3,6 +3,8 @@
 // including the reference's compacted-index bug (reference-behaviour §9.2).
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -171,12 +173,14 @@ class MonocularInitialiserTest : public ::testing::Test {
   }
 
   // Feeds frames until the initialiser succeeds; `spoil_mask` may change each frame's mask first.
-  static InitialisationAttempt Initialise(int* frame, const std::function<void(int, cv::Mat&)>& spoil_mask = {}) {
+  static InitialisationAttempt Initialise(int* frame, const std::function<void(int, cv::Mat&)>& spoil_mask = {},
+                                          double point_min_parallax_snr = 0) {
     const SequenceReader reader(*folder_);
     // 320x240 has about a quarter of the corners of 640x480: the count thresholds scale down.
     InitialisationOptions options;
     options.min_tracks = 50;
     options.min_points = 50;
+    options.point_min_parallax_snr = point_min_parallax_snr;
     MonocularInitialiser initialiser(reader.info().camera, FrontendOptions{}, 600, options);
     for (*frame = 0; *frame < reader.frame_count(); ++*frame) {
       const cv::Mat bgr = reader.ReadRgb(*frame);
@@ -266,6 +270,37 @@ TEST_F(MonocularInitialiserTest, PairsStayAlignedWhenReferenceCornersAreLost) {
   EXPECT_LT(errors[errors.size() * 3 / 4], 2.0);
   // And the map still has structure: better than all points at one depth.
   EXPECT_LT(Evaluate(map, frame).rmse_mm, Evaluate(map, frame, true).rmse_mm);
+}
+
+// The parallax gate relative to the epipolar error keeps a subset of the points the plain gate
+// keeps, fewer the stricter it is and never fewer than min_points; when too few would pass, it
+// keeps them all. It does not change when the map is accepted.
+TEST_F(MonocularInitialiserTest, RelativeParallaxGateKeepsFewerOfTheSamePoints) {
+  int frame = -1;
+  const InitialisationAttempt plain = Initialise(&frame);
+  ASSERT_TRUE(plain.success);
+  const size_t all = plain.map.seed.points.size();
+  std::set<std::pair<float, float>> plain_pixels;
+  for (const cv::Point2f& pixel : plain.map.seed.pixels) plain_pixels.emplace(pixel.x, pixel.y);
+  size_t fewest = all;
+  int gates_that_dropped = 0;
+  for (const double snr : {4.0, 8.0, 12.0, 16.0, 20.0, 1e9}) {
+    int gated_frame = -1;
+    const InitialisationAttempt gated = Initialise(&gated_frame, {}, snr);
+    ASSERT_TRUE(gated.success) << snr;
+    EXPECT_EQ(gated_frame, frame) << snr;
+    const size_t kept = gated.map.seed.points.size();
+    std::cout << "point_min_parallax_snr " << snr << ": " << kept << " of " << all << " points\n";
+    for (const cv::Point2f& pixel : gated.map.seed.pixels) EXPECT_TRUE(plain_pixels.count({pixel.x, pixel.y})) << snr;
+    if (kept == all) continue;
+    EXPECT_LE(kept, fewest) << snr;
+    EXPECT_GE(kept, 50u) << snr;
+    fewest = kept;
+    ++gates_that_dropped;
+  }
+  EXPECT_GE(gates_that_dropped, 2);  // measured: 62 and 52 of 70 points at 12 and 16
+  int frame_beyond = -1;
+  EXPECT_EQ(Initialise(&frame_beyond, {}, 1e9).map.seed.points.size(), all);  // none would pass
 }
 
 }  // namespace

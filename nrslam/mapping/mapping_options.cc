@@ -12,6 +12,7 @@ void InitialisationOptions::Check() const {
               "initialisation", "thresholds and median_depth must be positive");
   CheckOption(max_low_parallax_fraction >= 0 && max_low_parallax_fraction <= 1, "initialisation",
               "max_low_parallax_fraction must be in [0, 1]");
+  CheckOption(point_min_parallax_snr >= 0, "initialisation", "point_min_parallax_snr must be >= 0");
   CheckOption(initial_graph == "complete" || initial_graph == "flow_clusters", "initialisation",
               "initial_graph must be complete or flow_clusters, got '" + initial_graph + "'");
   CheckOption(dbscan_epsilon_px > 0 && dbscan_min_points >= 1, "initialisation", "DBSCAN parameters must be positive");

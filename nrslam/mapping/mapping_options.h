@@ -21,6 +21,11 @@ struct InitialisationOptions {
   double max_reprojection_px2 = 5.991;  // in both views
   int min_points = 100;              // triangulated points needed to accept
   double max_low_parallax_fraction = 0.25;  // of the E inliers; more means the baseline is still too short
+  // Once accepted, a point is kept only if its parallax is at least this many times the E
+  // inliers' robust epipolar error (1.4826 · median, pixel angles), when at least min_points
+  // pass. Deforming tissue moves points off their epipolar planes and along them alike, so
+  // that error says how much of a small parallax is deformation. 0 = off (the reference).
+  double point_min_parallax_snr = 0;
   double median_depth = 3.0;         // the map is scaled to this median depth, map units
   // Initial DDG: "complete" joins every pair of initial points (the reference); "flow_clusters"
   // joins only points whose optical flow since the reference falls in the same DBSCAN cluster.
@@ -31,7 +36,7 @@ struct InitialisationOptions {
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InitialisationOptions, min_tracks, max_reference_age, ransac_iterations,
                                                 epipolar_threshold_px, min_parallax_px, max_reprojection_px2, min_points,
-                                                max_low_parallax_fraction, median_depth, initial_graph,
+                                                max_low_parallax_fraction, point_min_parallax_snr, median_depth, initial_graph,
                                                 dbscan_epsilon_px, dbscan_min_points)
 
 struct MappingOptions {

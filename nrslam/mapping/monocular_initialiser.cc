@@ -146,9 +146,13 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
 
   std::vector<int> kept;
   std::vector<Eigen::Vector3d> points;
+  std::vector<double> parallaxes;
+  std::vector<double> epipolar_errors;
+  const Eigen::Matrix3d refined_essential = EssentialFromPose(current_from_reference);
   int low_parallax = 0;
   for (size_t i = 0; i < tracks.size(); ++i) {
     if (!essential->inliers[i]) continue;
+    epipolar_errors.push_back(std::abs(EpipolarAngle(refined_essential, reference[i], current[i])));
     const auto point = TriangulateMidpoint(Eigen::Vector3d::Zero(), reference[i], centre,
                                            reference_from_current * current[i]);
     if (!point || point->parallax_rad < min_parallax) {
@@ -167,12 +171,31 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
     }
     kept.push_back(tracks[i]);
     points.push_back(point->point);
+    parallaxes.push_back(point->parallax_rad);
   }
   const double low_fraction = static_cast<double>(low_parallax) / std::max(1, essential->inlier_count);
   if (static_cast<int>(points.size()) < options_.min_points || low_fraction > options_.max_low_parallax_fraction) {
     attempt.note = std::to_string(essential->inlier_count) + " E inliers, " + std::to_string(points.size()) +
                    " triangulated, " + std::to_string(static_cast<int>(100 * low_fraction)) + " % low parallax";
     return attempt;
+  }
+
+  if (options_.point_min_parallax_snr > 0) {
+    const double min_point_parallax = options_.point_min_parallax_snr * 1.4826 * Median(epipolar_errors);
+    const auto passes = [&](size_t i) { return parallaxes[i] >= min_point_parallax; };
+    size_t passing = 0;
+    for (size_t i = 0; i < points.size(); ++i) passing += passes(i);
+    if (static_cast<int>(passing) >= options_.min_points) {
+      size_t out = 0;
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (!passes(i)) continue;
+        kept[out] = kept[i];
+        points[out] = points[i];
+        ++out;
+      }
+      kept.resize(out);
+      points.resize(out);
+    }
   }
 
   // Scale: median reference-camera depth → options_.median_depth.
