@@ -257,11 +257,29 @@ TEST(Results, SweepSummaryCountsRunsBetterAndWorseThanTheDefault) {
   EXPECT_EQ(values[1].against_default.better, 3);
   EXPECT_EQ(values[1].against_default.same, 2);
   EXPECT_EQ(values[1].against_default.worse, 1);
+  EXPECT_DOUBLE_EQ(values[1].against_default.SignTestP(), 0.625);  // 3 against 1: 2 · 5/16
   for (size_t i : {2u, 3u}) EXPECT_FALSE(values[i].paired || values[i].is_default) << values[i].value;
   std::stringstream table;
   PrintResults(results, table);
   EXPECT_NE(table.str().find("3 / 2 / 1"), std::string::npos) << table.str();
   EXPECT_NE(table.str().find("(default)"), std::string::npos) << table.str();
+}
+
+// Known answers of the two-sided exact sign test: 2 · P(Binomial(n, 1/2) ≥ the larger count).
+TEST(Results, SignTestOverTheRunsThatMoved) {
+  const auto p = [](int better, int same, int worse) {
+    RmseChangeCounts counts;
+    counts.better = better;
+    counts.same = same;
+    counts.worse = worse;
+    return counts.SignTestP();
+  };
+  EXPECT_NEAR(p(11, 9, 5), 13770.0 / 65536, 1e-12);  // ties do not count
+  EXPECT_NEAR(p(5, 0, 11), 13770.0 / 65536, 1e-12);  // either direction
+  EXPECT_NEAR(p(10, 0, 0), 2.0 / 1024, 1e-15);
+  EXPECT_DOUBLE_EQ(p(8, 0, 8), 1.0);                 // an even split, capped at 1
+  EXPECT_DOUBLE_EQ(p(0, 7, 0), 1.0);                 // nothing moved
+  EXPECT_NEAR(p(600, 0, 400), 2.7284641560660184e-10, 1e-13);  // long sweeps neither overflow nor round to 0
 }
 
 // Known answers for two evaluations set side by side. Runs pair by sequence and sweep point:
@@ -303,7 +321,7 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
   EXPECT_EQ(diff.only_in_b, 1);
   std::stringstream table;
   PrintDiff(diff, "before", "after", table);
-  for (const char* expected : {"1 / 1 / 1", "absent", "FAILED", "-1.000", "0.500"}) {
+  for (const char* expected : {"1 / 1 / 1", "p = 1.000", "absent", "FAILED", "-1.000", "0.500"}) {
     EXPECT_NE(table.str().find(expected), std::string::npos) << expected << "\n" << table.str();
   }
   // A run without a trajectory error leaves the mean ATE out rather than averaging a gap.

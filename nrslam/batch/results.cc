@@ -77,6 +77,17 @@ void RmseChangeCounts::Add(double reference_mm, double rmse_mm) {
   ++(std::abs(change) < 5e-4 ? same : change < 0 ? better : worse);
 }
 
+double RmseChangeCounts::SignTestP() const {
+  const int moved = better + worse, larger = std::max(better, worse);
+  // Binomial(moved, 1/2) tail from `larger` up, each term by log-gamma so that long sweeps
+  // cannot overflow.
+  double tail = 0;
+  for (int k = larger; k <= moved; ++k) {
+    tail += std::exp(std::lgamma(moved + 1.0) - std::lgamma(k + 1.0) - std::lgamma(moved - k + 1.0) - moved * std::log(2.0));
+  }
+  return moved == 0 ? 1.0 : std::min(1.0, 2 * tail);
+}
+
 std::string RmseChangeCounts::ToString() const {
   return std::to_string(better) + " / " + std::to_string(same) + " / " + std::to_string(worse);
 }
@@ -198,15 +209,16 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
 
 std::vector<std::string> SweepSummaryHeader() {
   return {"option", "value", "mean RMSE mm", "median mm", "mean ATE mm", "runs", "not to end",
-          "vs default: better / same / worse"};
+          "vs default: better / same / worse", "sign test p"};
 }
 
 std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const bool any = v.runs > 0;
   const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
+  const std::string p = v.paired ? FormatFixed(v.against_default.SignTestP(), 3) : "-";
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
           any && v.mean_ate_mm >= 0 ? FormatFixed(v.mean_ate_mm, 3) : "-", std::to_string(v.runs),
-          std::to_string(v.short_runs), paired};
+          std::to_string(v.short_runs), paired, p};
 }
 
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results) {

@@ -34,6 +34,9 @@ struct RmseChangeCounts {
   int better = 0, same = 0, worse = 0;
   void Add(double reference_mm, double rmse_mm);
   std::string ToString() const;  // "better / same / worse"
+  // Two-sided exact sign test over the runs that moved (ties left out): the chance of a split
+  // at least this uneven if better and worse were equally likely. 1 when none moved.
+  double SignTestP() const;
 };
 
 // An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.

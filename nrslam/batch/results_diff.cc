@@ -95,7 +95,9 @@ void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::st
     summary.AddRow({"A", FormatFixed(diff.mean_rmse_a_mm, 3), FormatFixed(diff.median_rmse_a_mm, 3), ate(diff.mean_ate_a_mm)});
     summary.AddRow({"B", FormatFixed(diff.mean_rmse_b_mm, 3), FormatFixed(diff.median_rmse_b_mm, 3), ate(diff.mean_ate_b_mm)});
     summary.Print(out);
-    out << "B against A, run for run (better / same / worse): " << diff.b_against_a.ToString() << '\n';
+    out << "B against A, run for run (better / same / worse): " << diff.b_against_a.ToString()
+        << "; two-sided sign test over the runs that moved: p = " << FormatFixed(diff.b_against_a.SignTestP(), 3)
+        << '\n';
   }
   out << "Not tracked to the end (lost or failed): in A only " << diff.short_only_a << ", in B only "
       << diff.short_only_b << ", in both " << diff.short_both << '\n';
