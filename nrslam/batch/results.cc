@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
-#include <numeric>
 #include <sstream>
 
 #include "nrslam/system/system_options.h"
@@ -41,8 +40,7 @@ void ReadFigures(const Json& json, RunResult* result) {
 std::map<std::string, bool> CompleteSequences(const std::vector<RunResult>& results) {
   std::map<std::string, bool> complete;
   for (const RunResult& r : results) {
-    const bool ok = r.status == "ok" && r.evaluated();
-    complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && ok : ok;
+    complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && r.complete() : r.complete();
   }
   return complete;
 }
@@ -81,10 +79,9 @@ double RmseChangeCounts::SignTestP() const {
   const int moved = better + worse, larger = std::max(better, worse);
   // Binomial(moved, 1/2) tail from `larger` up, each term by log-gamma so that long sweeps
   // cannot overflow.
+  const double log_all_splits = std::lgamma(moved + 1.0) - moved * std::log(2.0);
   double tail = 0;
-  for (int k = larger; k <= moved; ++k) {
-    tail += std::exp(std::lgamma(moved + 1.0) - std::lgamma(k + 1.0) - std::lgamma(moved - k + 1.0) - moved * std::log(2.0));
-  }
+  for (int k = larger; k <= moved; ++k) tail += std::exp(log_all_splits - std::lgamma(k + 1.0) - std::lgamma(moved - k + 1.0));
   return moved == 0 ? 1.0 : std::min(1.0, 2 * tail);
 }
 
@@ -245,7 +242,6 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       cell.ate_everywhere &= r.ate_mm >= 0;
     }
   }
-  const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
   const auto has = [](const RunResult& r, const std::string& assignment) {
     return std::find(r.point.begin(), r.point.end(), assignment) != r.point.end();
   };
@@ -268,9 +264,9 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       summary.runs = static_cast<int>(cell.rmse.size());
       summary.short_runs = cell.short_runs;
       if (!cell.rmse.empty()) {
-        summary.mean_rmse_mm = mean(cell.rmse);
+        summary.mean_rmse_mm = Mean(cell.rmse);
         summary.median_rmse_mm = Median(cell.rmse);
-        if (cell.ate_everywhere) summary.mean_ate_mm = mean(cell.ate);
+        if (cell.ate_everywhere) summary.mean_ate_mm = Mean(cell.ate);
       }
       summary.is_default = value == default_value;
       summary.paired = !default_value.empty() && !summary.is_default;

@@ -24,6 +24,8 @@ struct RunResult {
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
   std::string run_folder;
   bool evaluated() const { return frames_evaluated > 0; }
+  // Tracked to the end with ground truth: the runs whose RMSEs compare like with like.
+  bool complete() const { return status == "ok" && evaluated(); }
 };
 
 // How tables and baselines name a run: "sequence", or "sequence [sweep point]".

@@ -1,19 +1,13 @@
 #include "nrslam/batch/results_diff.h"
 
+#include <algorithm>
 #include <map>
-#include <numeric>
 
 #include "nrslam/util/median.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
 namespace {
-
-bool Complete(const RunResult& run) { return run.status == "ok" && run.evaluated(); }
-
-double Mean(const std::vector<double>& values) {
-  return std::accumulate(values.begin(), values.end(), 0.0) / values.size();
-}
 
 // RMSE and frames of one side of a row, as the table shows them.
 std::vector<std::string> SideCells(const std::optional<RunResult>& run) {
@@ -24,8 +18,6 @@ std::vector<std::string> SideCells(const std::optional<RunResult>& run) {
 }
 
 }  // namespace
-
-bool ResultsDiff::Row::comparable() const { return a && b && Complete(*a) && Complete(*b); }
 
 ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunResult>& b) {
   ResultsDiff diff;
@@ -42,25 +34,21 @@ ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunRe
       diff.rows.push_back({RunKey(run), std::nullopt, run});
     }
   }
-  std::vector<double> rmse_a, rmse_b;
-  bool ate_a = true, ate_b = true;
-  double ate_sum_a = 0, ate_sum_b = 0;
+  std::vector<double> rmse_a, rmse_b, ate_a, ate_b;
   for (const ResultsDiff::Row& row : diff.rows) {
     if (!row.a || !row.b) {
       ++(row.a ? diff.only_in_a : diff.only_in_b);
       continue;
     }
     if (!row.comparable()) {
-      const bool a_short = !Complete(*row.a), b_short = !Complete(*row.b);
+      const bool a_short = !row.a->complete(), b_short = !row.b->complete();
       ++(a_short && b_short ? diff.short_both : a_short ? diff.short_only_a : diff.short_only_b);
       continue;
     }
     rmse_a.push_back(row.a->rmse_mm);
     rmse_b.push_back(row.b->rmse_mm);
-    ate_a &= row.a->ate_mm >= 0;
-    ate_b &= row.b->ate_mm >= 0;
-    ate_sum_a += row.a->ate_mm;
-    ate_sum_b += row.b->ate_mm;
+    ate_a.push_back(row.a->ate_mm);
+    ate_b.push_back(row.b->ate_mm);
     diff.b_against_a.Add(row.a->rmse_mm, row.b->rmse_mm);
   }
   diff.comparable = static_cast<int>(rmse_a.size());
@@ -69,8 +57,11 @@ ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunRe
     diff.mean_rmse_b_mm = Mean(rmse_b);
     diff.median_rmse_a_mm = Median(rmse_a);
     diff.median_rmse_b_mm = Median(rmse_b);
-    if (ate_a) diff.mean_ate_a_mm = ate_sum_a / diff.comparable;
-    if (ate_b) diff.mean_ate_b_mm = ate_sum_b / diff.comparable;
+    const auto all_present = [](const std::vector<double>& ate) {
+      return std::all_of(ate.begin(), ate.end(), [](double mm) { return mm >= 0; });
+    };
+    if (all_present(ate_a)) diff.mean_ate_a_mm = Mean(ate_a);
+    if (all_present(ate_b)) diff.mean_ate_b_mm = Mean(ate_b);
   }
   return diff;
 }

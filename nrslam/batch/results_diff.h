@@ -16,8 +16,7 @@ struct ResultsDiff {
   struct Row {
     std::string key;                 // RunKey
     std::optional<RunResult> a, b;   // absent: the run is not in that evaluation
-    // Tracked to the end with ground truth in both, so the two RMSEs compare like with like.
-    bool comparable() const;
+    bool comparable() const { return a && b && a->complete() && b->complete(); }
   };
   std::vector<Row> rows;             // A's runs in A's order, then B's runs A lacks
   // Over the comparable rows only (single runs are chaotic: the counts say more than the means).

@@ -6,6 +6,7 @@
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/median.h"
 
 namespace nrslam {
 
@@ -115,7 +116,7 @@ SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames) {
   }
   metrics.frames_evaluated = static_cast<int>(rmses.size());
   if (rmses.empty()) return metrics;
-  metrics.rmse_mm = std::accumulate(rmses.begin(), rmses.end(), 0.0) / rmses.size();
+  metrics.rmse_mm = Mean(rmses);
   std::sort(rmses.begin(), rmses.end());
   const size_t n = rmses.size();
   metrics.rmse_median_mm = n % 2 ? rmses[n / 2] : 0.5 * (rmses[n / 2 - 1] + rmses[n / 2]);

@@ -147,12 +147,9 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
   std::vector<int> kept;
   std::vector<Eigen::Vector3d> points;
   std::vector<double> parallaxes;
-  std::vector<double> epipolar_errors;
-  const Eigen::Matrix3d refined_essential = EssentialFromPose(current_from_reference);
   int low_parallax = 0;
   for (size_t i = 0; i < tracks.size(); ++i) {
     if (!essential->inliers[i]) continue;
-    epipolar_errors.push_back(std::abs(EpipolarAngle(refined_essential, reference[i], current[i])));
     const auto point = TriangulateMidpoint(Eigen::Vector3d::Zero(), reference[i], centre,
                                            reference_from_current * current[i]);
     if (!point || point->parallax_rad < min_parallax) {
@@ -181,20 +178,22 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
   }
 
   if (options_.point_min_parallax_snr > 0) {
+    const Eigen::Matrix3d refined_essential = EssentialFromPose(current_from_reference);
+    std::vector<double> epipolar_errors;
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      if (essential->inliers[i]) epipolar_errors.push_back(std::abs(EpipolarAngle(refined_essential, reference[i], current[i])));
+    }
     const double min_point_parallax = options_.point_min_parallax_snr * 1.4826 * Median(epipolar_errors);
-    const auto passes = [&](size_t i) { return parallaxes[i] >= min_point_parallax; };
-    size_t passing = 0;
-    for (size_t i = 0; i < points.size(); ++i) passing += passes(i);
-    if (static_cast<int>(passing) >= options_.min_points) {
-      size_t out = 0;
-      for (size_t i = 0; i < points.size(); ++i) {
-        if (!passes(i)) continue;
-        kept[out] = kept[i];
-        points[out] = points[i];
-        ++out;
-      }
-      kept.resize(out);
-      points.resize(out);
+    std::vector<int> passing_tracks;
+    std::vector<Eigen::Vector3d> passing_points;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (parallaxes[i] < min_point_parallax) continue;
+      passing_tracks.push_back(kept[i]);
+      passing_points.push_back(points[i]);
+    }
+    if (static_cast<int>(passing_points.size()) >= options_.min_points) {
+      kept = std::move(passing_tracks);
+      points = std::move(passing_points);
     }
   }
 
