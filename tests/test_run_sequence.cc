@@ -415,6 +415,22 @@ TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {
   EXPECT_GT(adaptive.new_points, reference.new_points);
 }
 
+TEST(MonocularRun, StarvingMapDropsTheTwoRayCheck) {
+  // Even over the shortest span, the tissue moves about as far as the camera, so many
+  // candidates' rigid rays miss each other; a starving map (here: every frame, fraction 1)
+  // gates on parallax alone and leaves the rest to the deformable fit's own checks.
+  SystemOptions checked, parallax_only;
+  checked.mapping.shortest_gate_below_fraction = parallax_only.mapping.shortest_gate_below_fraction = 1;
+  checked.mapping.starving_two_ray_check = true;
+  parallax_only.mapping.starving_two_ray_check = false;
+  const MonocularOutcome reference = RunMonocular("sim-3", checked);
+  const MonocularOutcome outcome = RunMonocular("sim-3", parallax_only);
+  ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
+  std::cout << "deformable candidates with / without the two-ray check: " << reference.deformable_candidates << " / "
+            << outcome.deformable_candidates << "\n";
+  EXPECT_GT(outcome.deformable_candidates, reference.deformable_candidates);
+}
+
 // New points are triangulated on every core (mapper.cc); the map must not depend on how many.
 TEST(MonocularRun, TriangulationOnTwoThreadsGivesTheSameRunAsOne) {
   omp_set_num_threads(1);

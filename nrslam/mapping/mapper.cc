@@ -208,29 +208,31 @@ Eigen::Vector3d Mapper::WorldRay(const CandidateTrack& track, size_t i) const {
   return track.frames[i]->cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels[i]).normalized();
 }
 
-std::optional<Triangulated> Mapper::TriangulatePair(const CandidateTrack& track, size_t a, size_t b) const {
+std::optional<Triangulated> Mapper::TriangulatePair(const CandidateTrack& track, size_t a, size_t b,
+                                                    bool check_reprojection) const {
   const Snapshot& first = *track.frames[a];
   const Snapshot& last = *track.frames[b];
   const auto point = TriangulateMidpoint(first.cam_from_world.Inverse().translation, WorldRay(track, a),
                                          last.cam_from_world.Inverse().translation, WorldRay(track, b));
-  if (!point || point->depth0 <= 0 || point->depth1 <= 0 ||
-      SquaredReprojectionError(camera_, first.cam_from_world, point->point, track.pixels[a]) >
+  if (!point || point->depth0 <= 0 || point->depth1 <= 0) return std::nullopt;
+  if (check_reprojection &&
+      (SquaredReprojectionError(camera_, first.cam_from_world, point->point, track.pixels[a]) >
           options_.max_reprojection_px2 ||
-      SquaredReprojectionError(camera_, last.cam_from_world, point->point, track.pixels[b]) >
-          options_.max_reprojection_px2) {
+       SquaredReprojectionError(camera_, last.cam_from_world, point->point, track.pixels[b]) >
+           options_.max_reprojection_px2)) {
     return std::nullopt;
   }
   return point;
 }
 
-std::optional<Triangulated> Mapper::TriangulateShortestSpan(const CandidateTrack& track) const {
+std::optional<Triangulated> Mapper::TriangulateShortestSpan(const CandidateTrack& track, bool check_reprojection) const {
   // Enough parallax: an angle ≥ the minimum, i.e. a cosine ≤ its cosine (unit rays).
   const double max_cosine = std::cos(options_.deformable_min_parallax_px / camera_.MeanFocal());
   const size_t newest = track.frames.size() - 1;
   const Eigen::Vector3d newest_ray = WorldRay(track, newest);
   for (size_t a = newest; a-- > 0;) {
     if (WorldRay(track, a).dot(newest_ray) <= max_cosine) {
-      return TriangulatePair(track, a, newest);
+      return TriangulatePair(track, a, newest, check_reprojection);
     }
   }
   return std::nullopt;
@@ -340,7 +342,7 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrac
   return newest.Inverse() * (ray * along);
 }
 
-Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation& candidate, bool shortest_gate,
+Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation& candidate, bool starving,
                                                      double map_scale) const {
   CandidatePoints points;
   const Snapshot& newest = buffer_.back();
@@ -385,7 +387,9 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
   if (const auto point = TriangulateRigid(track, ends, map_scale); point && plausible(*point)) points.rigid = point;
   if (!rigid_ && options_.deformable_triangulation &&
       static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-    const std::optional<Triangulated> gate = shortest_gate ? TriangulateShortestSpan(track) : ends;
+    const bool shortest_gate = options_.deformable_gate_span == "shortest" || starving;
+    const std::optional<Triangulated> gate =
+        shortest_gate ? TriangulateShortestSpan(track, !starving || options_.starving_two_ray_check) : ends;
     if (const auto point = TriangulateDeformable(track, gate, neighbours, map_scale); point && plausible(*point)) {
       points.deformable = point;
     }
@@ -399,13 +403,12 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   Map& map = tracker->mutable_map();
   const bool starving = two_view_map_ && static_cast<double>(result.points.size()) <
                                             options_.shortest_gate_below_fraction * static_cast<double>(start_points_);
-  const bool shortest_gate = options_.deformable_gate_span == "shortest" || starving;
   // Each candidate is its own small problem: they are solved on every core, each into its own
   // slot, and gathered in candidate order, so the outcome is the same as one at a time.
   const int count = static_cast<int>(result.candidates.size());
   std::vector<CandidatePoints> solved(result.candidates.size());
 #pragma omp parallel for schedule(dynamic, 4)
-  for (int c = 0; c < count; ++c) solved[c] = TriangulateCandidate(result.candidates[c], shortest_gate, map.scale());
+  for (int c = 0; c < count; ++c) solved[c] = TriangulateCandidate(result.candidates[c], starving, map.scale());
   std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
   for (int c = 0; c < count; ++c) {
     if (solved[c].rigid) rigid.emplace_back(result.candidates[c].track_id, *solved[c].rigid);

@@ -107,18 +107,20 @@ class Mapper {
   struct CandidatePoints {
     std::optional<Eigen::Vector3d> rigid, deformable;
   };
-  CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, bool shortest_gate,
+  CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, bool starving,
                                        double map_scale) const;
   // Observation i's viewing ray, in the world frame.
   Eigen::Vector3d WorldRay(const CandidateTrack& track, size_t i) const;
-  // The rays of observations a and b met in the middle, if both lie in front and it
-  // reprojects within max_reprojection_px2 in both views. Over the first and last
-  // observations: the rigid answer, and the deformable triangulation's reference gate.
-  std::optional<Triangulated> TriangulatePair(const CandidateTrack& track, size_t a, size_t b) const;
+  // The rays of observations a and b met in the middle, if both lie in front and (when
+  // check_reprojection) it reprojects within max_reprojection_px2 in both views. Over the
+  // first and last observations: the rigid answer, and the deformable triangulation's
+  // reference gate.
+  std::optional<Triangulated> TriangulatePair(const CandidateTrack& track, size_t a, size_t b,
+                                              bool check_reprojection = true) const;
   // The same over the newest observation and the latest earlier one with
   // deformable_min_parallax_px of parallax (mapping.deformable_gate_span=shortest, and on
   // frames below mapping.shortest_gate_below_fraction of a monocular map's first points).
-  std::optional<Triangulated> TriangulateShortestSpan(const CandidateTrack& track) const;
+  std::optional<Triangulated> TriangulateShortestSpan(const CandidateTrack& track, bool check_reprojection) const;
   std::optional<Eigen::Vector3d> TriangulateRigid(const CandidateTrack& track, const std::optional<Triangulated>& ends,
                                                   double map_scale) const;
   std::optional<Eigen::Vector3d> TriangulateDeformable(const CandidateTrack& track,

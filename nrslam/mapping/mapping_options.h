@@ -96,6 +96,12 @@ struct MappingOptions {
   // start accurate, and the looser gate's points cost them more than they add (measured in
   // the top-level README, "Mapping").
   double shortest_gate_below_fraction = 0.35;
+  // On those frames, whether the gate's two rays must also reproject within
+  // max_reprojection_px2. Even over the shortest span the tissue moves about as far as the
+  // camera, so in the 300-frame sim-3 run's dip 100-290 candidates per frame still failed it
+  // and 5 late frames tracked fewer than 100 points. false (default): parallax and positive
+  // depths only; the deformable fit's own outlier checks and max_depth_ratio remain.
+  bool starving_two_ray_check = false;
   int deformable_min_track = 5;      // deformable triangulation needs this many observations
   double deformable_min_parallax_px = 5;
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
@@ -111,7 +117,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_triangulation, deformable_gate_span,
-                                                shortest_gate_below_fraction, deformable_min_track, deformable_min_parallax_px,
+                                                shortest_gate_below_fraction, starving_two_ray_check, deformable_min_track, deformable_min_parallax_px,
                                                 flow_sigma, deformable_iterations, flow_outlier_chi2,
                                                 reprojection_outlier_chi2, model_selection_factor)
 
