@@ -342,8 +342,8 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrac
   return newest.Inverse() * (ray * along);
 }
 
-Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation& candidate, bool starving,
-                                                     double map_scale) const {
+Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation& candidate,
+                                                     const DeformableGate& gate, double map_scale) const {
   CandidatePoints points;
   const Snapshot& newest = buffer_.back();
   const double crowding2 = options_.crowding_radius_px * options_.crowding_radius_px;
@@ -387,10 +387,9 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
   if (const auto point = TriangulateRigid(track, ends, map_scale); point && plausible(*point)) points.rigid = point;
   if (!rigid_ && options_.deformable_triangulation &&
       static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
-    const bool shortest_gate = options_.deformable_gate_span == "shortest" || starving;
-    const std::optional<Triangulated> gate =
-        shortest_gate ? TriangulateShortestSpan(track, !starving || options_.starving_two_ray_check) : ends;
-    if (const auto point = TriangulateDeformable(track, gate, neighbours, map_scale); point && plausible(*point)) {
+    const std::optional<Triangulated> gate_pair =
+        gate.shortest_span ? TriangulateShortestSpan(track, gate.check_reprojection) : ends;
+    if (const auto point = TriangulateDeformable(track, gate_pair, neighbours, map_scale); point && plausible(*point)) {
       points.deformable = point;
     }
   }
@@ -403,12 +402,15 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   Map& map = tracker->mutable_map();
   const bool starving = two_view_map_ && static_cast<double>(result.points.size()) <
                                             options_.shortest_gate_below_fraction * static_cast<double>(start_points_);
+  DeformableGate gate;
+  gate.shortest_span = options_.deformable_gate_span == "shortest" || starving;
+  gate.check_reprojection = !starving || options_.starving_two_ray_check;
   // Each candidate is its own small problem: they are solved on every core, each into its own
   // slot, and gathered in candidate order, so the outcome is the same as one at a time.
   const int count = static_cast<int>(result.candidates.size());
   std::vector<CandidatePoints> solved(result.candidates.size());
 #pragma omp parallel for schedule(dynamic, 4)
-  for (int c = 0; c < count; ++c) solved[c] = TriangulateCandidate(result.candidates[c], starving, map.scale());
+  for (int c = 0; c < count; ++c) solved[c] = TriangulateCandidate(result.candidates[c], gate, map.scale());
   std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
   for (int c = 0; c < count; ++c) {
     if (solved[c].rigid) rigid.emplace_back(result.candidates[c].track_id, *solved[c].rigid);

@@ -107,7 +107,13 @@ class Mapper {
   struct CandidatePoints {
     std::optional<Eigen::Vector3d> rigid, deformable;
   };
-  CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, bool starving,
+  // A frame's deformable-triangulation gate: over which span (mapping.deformable_gate_span, or
+  // the shortest on a starving frame) and whether its two rays must reproject.
+  struct DeformableGate {
+    bool shortest_span = false;
+    bool check_reprojection = true;
+  };
+  CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, const DeformableGate& gate,
                                        double map_scale) const;
   // Observation i's viewing ray, in the world frame.
   Eigen::Vector3d WorldRay(const CandidateTrack& track, size_t i) const;
