@@ -80,7 +80,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   }
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
-       << "), trajectory error " << AteCell(result) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
+       << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
     const Json config = ReadJsonFile(run / "config.json");
@@ -198,7 +198,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::filesystem::p
     }
     html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
-         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << AteCell(r) << "</td><td>" << FormatFixed(r.fps, 1)
+         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
   html << "</table>\n" << SweepSection(results);

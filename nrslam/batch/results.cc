@@ -40,7 +40,8 @@ void ReadFigures(const Json& json, RunResult* result) {
 std::map<std::string, bool> CompleteSequences(const std::vector<RunResult>& results) {
   std::map<std::string, bool> complete;
   for (const RunResult& r : results) {
-    complete[r.sequence] = complete.count(r.sequence) ? complete[r.sequence] && r.complete() : r.complete();
+    bool& all = complete.emplace(r.sequence, true).first->second;
+    all = all && r.complete();
   }
   return complete;
 }
@@ -93,7 +94,7 @@ std::string RmseCell(const RunResult& result, double rmse_mm) {
   return result.evaluated() ? FormatFixed(rmse_mm, 3) : "no GT";
 }
 
-std::string AteCell(const RunResult& result) { return result.ate_mm >= 0 ? FormatFixed(result.ate_mm, 3) : "-"; }
+std::string AteCell(double ate_mm) { return ate_mm >= 0 ? FormatFixed(ate_mm, 3) : "-"; }
 
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
   std::vector<RunResult> results;
@@ -185,7 +186,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     } else {
       row.insert(row.end(), {r.status, std::to_string(r.init_frame),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
-                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), AteCell(r), FormatFixed(r.fps, 1)});
+                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), AteCell(r.ate_mm), FormatFixed(r.fps, 1)});
     }
     table.AddRow(row);
   }
@@ -214,7 +215,7 @@ std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
   const std::string p = v.paired ? FormatFixed(v.against_default.SignTestP(), 3) : "-";
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
-          any && v.mean_ate_mm >= 0 ? FormatFixed(v.mean_ate_mm, 3) : "-", std::to_string(v.runs),
+          any ? AteCell(v.mean_ate_mm) : "-", std::to_string(v.runs),
           std::to_string(v.short_runs), paired, p};
 }
 

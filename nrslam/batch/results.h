@@ -43,8 +43,8 @@ struct RmseChangeCounts {
 
 // An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
 std::string RmseCell(const RunResult& result, double rmse_mm);
-// The trajectory error as a table shows it: "-" when there was none.
-std::string AteCell(const RunResult& result);
+// A trajectory error (a run's or a mean) as a table shows it: "-" when there was none (negative).
+std::string AteCell(double ate_mm);
 
 // Reads each run's summary.json (or failure.json) from its folder.
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan);
