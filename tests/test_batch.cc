@@ -102,7 +102,8 @@ TEST(Manifest, ShippedSimulationManifestsAreValid) {
     EXPECT_EQ(PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache").runs.size(), manifest.sequences.size());
     ++checked;
   }
-  EXPECT_GE(checked, 4);  // ci-sim, paper-sim, paper-sim-monocular, colon-seeds-monocular
+  // ci-sim, ci-sim-monocular, paper-sim, paper-sim-monocular, colon-seeds-monocular, colon-long-wave-monocular
+  EXPECT_GE(checked, 6);
   std::filesystem::remove_all(folder);
 }
 
@@ -362,6 +363,9 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   ASSERT_EQ(read.size(), 3u);
   EXPECT_EQ(read[1].error, results[1].error);
   EXPECT_DOUBLE_EQ(read[0].rmse_mm, results[0].rmse_mm);
+  EXPECT_GT(results[0].rmse_flat_mm, 0.0);
+  EXPECT_DOUBLE_EQ(read[0].rmse_flat_mm, results[0].rmse_flat_mm);
+  EXPECT_LT(read[1].rmse_flat_mm, 0.0);  // failed: none recorded
 
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,
   // and the failed sequence is shown as such.
@@ -376,8 +380,9 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   std::ifstream dom_stream(dom), log_stream(log);
   const std::string page((std::istreambuf_iterator<char>(dom_stream)), {});
   const std::string browser((std::istreambuf_iterator<char>(log_stream)), {});
-  // Two tracked runs: each an RMSE plot, a trajectory plot (two series) and three images.
-  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=4 series=6\""), std::string::npos)
+  // Two tracked runs: each an RMSE plot (the run and the flat map), a trajectory plot (two
+  // series) and three images.
+  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=4 series=8\""), std::string::npos)
       << page.substr(0, 2000);
   EXPECT_NE(page.find("Failed: exit code 1"), std::string::npos);
   EXPECT_EQ(browser.find("Uncaught"), std::string::npos) << browser;

@@ -83,6 +83,28 @@ TEST(DepthEvaluation, PointsOnInvalidGroundTruthAreExcludedAndCounted) {
   EXPECT_NEAR(result.rmse_mm, 0.0, 1e-9);
 }
 
+TEST(DepthEvaluation, TheFlatMapScoresTheSpreadOfTheTrueDepths) {
+  // Truth 20, 22, …, 58 mm on a ramp; the estimates follow it exactly. A map at one depth can
+  // only be scaled to the (trimmed) mean, so its RMSE is the spread of the truth around it.
+  cv::Mat depth(40, 60, CV_32F);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 60; ++x) depth.at<float>(y, x) = 20.0f + 2.0f * static_cast<float>(x);
+  }
+  std::vector<DepthPoint> points;
+  for (int x = 0; x < 20; ++x) points.push_back({{static_cast<double>(x), 20.0}, 0.1 * (20.0 + 2.0 * x)});
+  EvaluationOptions untrimmed;
+  untrimmed.keep_fraction = 1.0;
+  const FrameEvaluation result = EvaluateFrame(points, depth, untrimmed);
+  ASSERT_TRUE(result.evaluated);
+  EXPECT_NEAR(result.rmse_mm, 0.0, 1e-9);
+  // Truth 20 + 2x, x = 0…19: around its mean, the spread is 2·√((20² − 1)/12).
+  EXPECT_NEAR(result.flat_rmse_mm, 2.0 * std::sqrt((20.0 * 20.0 - 1.0) / 12.0), 1e-9);
+  // Trimmed (the default), the flat map drops its worst point, an end of the ramp.
+  const FrameEvaluation trimmed = EvaluateFrame(points, depth, EvaluationOptions{});
+  EXPECT_EQ(trimmed.points_kept, 19);
+  EXPECT_NEAR(trimmed.flat_rmse_mm, 2.0 * std::sqrt((19.0 * 19.0 - 1.0) / 12.0), 1e-9);
+}
+
 TEST(DepthEvaluation, TooFewPointsOrBadInputAreReportedNotGuessed) {
   EXPECT_FALSE(EvaluateDepthPairs({1.0, 2.0}, {10.0, 20.0}, EvaluationOptions{}).evaluated);
   EXPECT_THROW(EvaluateDepthPairs({1.0, NAN, 1, 1, 1}, {1, 1, 1, 1, 1}, EvaluationOptions{}), Error);
@@ -98,12 +120,15 @@ TEST(DepthEvaluation, SequenceAggregates) {
     frames[i].rmse_mm = rmse[i];
     frames[i].points_kept = 100;
     frames[i].squared_error_sum = rmse[i] * rmse[i] * 100;
+    frames[i].flat_rmse_mm = 10.0 * rmse[i];
   }
+  frames[3].flat_rmse_mm = 99.0;  // not evaluated: must not count
   const SequenceMetrics metrics = AggregateFrames(frames);  // the 4th frame was not evaluated
   EXPECT_EQ(metrics.frames_evaluated, 3);
   EXPECT_NEAR(metrics.rmse_mm, 7.0 / 3.0, 1e-12);
   EXPECT_NEAR(metrics.rmse_median_mm, 2.0, 1e-12);
   EXPECT_NEAR(metrics.rmse_pooled_mm, std::sqrt(21.0 / 3.0), 1e-12);
+  EXPECT_NEAR(metrics.rmse_flat_mm, 70.0 / 3.0, 1e-12);
 }
 
 // Run a keeps ten exact points and ten bad ones; run b only the ten exact ones (and one of its

@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
     std::cout << "frames tracked " << summary.frames_tracked << "/" << summary.frames_total << " (init at "
               << summary.init_frame << ", lost " << summary.frames_lost << ")  ";
     if (summary.frames_evaluated > 0) {
-      std::cout << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm  ";
+      std::cout << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
+                << summary.rmse_flat_mm << " mm)  ";
     } else {
       std::cout << "no ground truth, no RMSE  ";
     }

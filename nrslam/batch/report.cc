@@ -80,13 +80,14 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   }
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
-       << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
+       << "; a map at one depth: " << FlatRmseCell(result) << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
     const Json config = ReadJsonFile(run / "config.json");
     const SequenceReader sequence(config.at("sequence").get<std::string>());
     const auto metrics = ReadCsv(run / "metrics.csv");
     PlotSeries rmse{"depth RMSE", "#1f77b4", {}, {}};
+    PlotSeries flat{"a map at one depth", "#999999", {}, {}};  // runs before it was recorded have none
     std::map<int, double> scales;
     std::vector<int> tracked;
     for (const auto& row : metrics) {
@@ -94,11 +95,16 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
       const int frame = static_cast<int>(Number(row, "frame"));
       rmse.x.push_back(frame);
       rmse.y.push_back(Number(row, "rmse_mm"));
+      if (row.count("rmse_flat_mm") != 0) {
+        flat.x.push_back(frame);
+        flat.y.push_back(Number(row, "rmse_flat_mm"));
+      }
       scales[frame] = Number(row, "scale");
       tracked.push_back(frame);
     }
     html << "<div class=\"plots\">"
-         << LinePlotSvg({rmse}, {"Depth RMSE per frame", "frame", "RMSE (mm)", 520, 300, false});
+         << LinePlotSvg(flat.x.empty() ? std::vector<PlotSeries>{rmse} : std::vector<PlotSeries>{rmse, flat},
+                        {"Depth RMSE per frame", "frame", "RMSE (mm)", 520, 300, false});
     if (sequence.has_groundtruth() && std::filesystem::exists(run / "trajectory.tum")) {
       const Trajectories top = TopView(run / "trajectory.tum", sequence.groundtruth());
       html << LinePlotSvg({top.truth, top.estimate}, {"Trajectory, top view", "x (mm)", "z (mm)", 520, 300, true});
@@ -188,17 +194,17 @@ void WriteReport(const std::vector<RunResult>& results, const std::filesystem::p
           "{text-align:left}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
           "figure{margin:0}section{margin-top:28px}</style></head><body>\n<h1>nrslam evaluation</h1>\n";
   html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
-          "<th>ATE mm</th><th>fps</th></tr>\n";
+          "<th>flat mm</th><th>ATE mm</th><th>fps</th></tr>\n";
   for (const RunResult& r : results) {
     const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
     html << "<tr><td><a href=\"#" << EscapeXml(Slug(r)) << "\">" << EscapeXml(key) << "</a></td>";
     if (r.status == "failed") {
-      html << "<td class=\"failed\">FAILED</td><td colspan=\"6\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
+      html << "<td class=\"failed\">FAILED</td><td colspan=\"7\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
       continue;
     }
     html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
-         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
+         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FlatRmseCell(r) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
   html << "</table>\n" << SweepSection(results);

@@ -31,6 +31,8 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
+  const auto flat = json.find("rmse_flat_mm");
+  result->rmse_flat_mm = flat != json.end() && flat->is_number() ? flat->get<double>() : -1.0;
   result->fps = json.value("fps", 0.0);
   const auto ate = json.find("ate_rmse_mm");
   result->ate_mm = ate != json.end() && ate->is_number() ? ate->get<double>() : -1.0;
@@ -94,6 +96,10 @@ std::string RmseCell(const RunResult& result, double rmse_mm) {
   return result.evaluated() ? FormatFixed(rmse_mm, 3) : "no GT";
 }
 
+std::string FlatRmseCell(const RunResult& result) {
+  return result.rmse_flat_mm >= 0 ? RmseCell(result, result.rmse_flat_mm) : "-";
+}
+
 std::string AteCell(double ate_mm) { return ate_mm >= 0 ? FormatFixed(ate_mm, 3) : "-"; }
 
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
@@ -127,6 +133,7 @@ Json ToJson(const std::vector<RunResult>& results) {
     rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
+                    {"rmse_flat_mm", r.rmse_flat_mm >= 0 ? Json(r.rmse_flat_mm) : Json()},
                     {"ate_rmse_mm", r.ate_mm >= 0 ? Json(r.ate_mm) : Json()}, {"fps", r.fps}, {"run_folder", r.run_folder}});
   }
   return {{"results", rows}};
@@ -157,10 +164,12 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
-         "ate_rmse_mm,fps,error\n";
+         "rmse_flat_mm,ate_rmse_mm,fps,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',';
+    if (r.rmse_flat_mm >= 0) csv << r.rmse_flat_mm;  // empty when not recorded
+    csv << ',';
     if (r.ate_mm >= 0) csv << r.ate_mm;  // empty without a trajectory error
     csv << ',' << r.fps
         << ',' << CsvField(r.error) << '\n';
@@ -176,17 +185,18 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   for (const RunResult& r : results) swept |= !r.label.empty();
   std::vector<std::string> header = {"sequence"};
   if (swept) header.push_back("sweep point");
-  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "ATE mm", "fps"}) header.push_back(column);
+  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "flat mm", "ATE mm", "fps"}) header.push_back(column);
   TextTable table(header);
   for (const RunResult& r : results) {
     std::vector<std::string> row = {r.sequence};
     if (swept) row.push_back(r.label);
     if (r.status == "failed") {
-      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
+      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
     } else {
       row.insert(row.end(), {r.status, std::to_string(r.init_frame),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
-                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), AteCell(r.ate_mm), FormatFixed(r.fps, 1)});
+                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), FlatRmseCell(r), AteCell(r.ate_mm),
+                             FormatFixed(r.fps, 1)});
     }
     table.AddRow(row);
   }

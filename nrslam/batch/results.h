@@ -22,6 +22,7 @@ struct RunResult {
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
+  double rmse_flat_mm = -1;         // what a map at one depth scores on the same points; negative: not recorded
   std::string run_folder;
   bool evaluated() const { return frames_evaluated > 0; }
   // Tracked to the end with ground truth: the runs whose RMSEs compare like with like.
@@ -43,6 +44,8 @@ struct RmseChangeCounts {
 
 // An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
 std::string RmseCell(const RunResult& result, double rmse_mm);
+// A run's flat-map RMSE as a table shows it: "-" for results written before it was recorded.
+std::string FlatRmseCell(const RunResult& result);
 // A trajectory error (a run's or a mean) as a table shows it: "-" when there was none (negative).
 std::string AteCell(double ate_mm);
 

@@ -100,23 +100,28 @@ FrameEvaluation EvaluateFrame(const std::vector<DepthPoint>& points, const cv::M
   }
   FrameEvaluation result = EvaluateDepthPairs(estimated, groundtruth, options);
   result.points_without_groundtruth = without;
+  if (result.evaluated) {
+    result.flat_rmse_mm = EvaluateDepthPairs(std::vector<double>(groundtruth.size(), 1.0), groundtruth, options).rmse_mm;
+  }
   return result;
 }
 
 SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames) {
   SequenceMetrics metrics;
-  std::vector<double> rmses;
+  std::vector<double> rmses, flat_rmses;
   double squared = 0.0;
   long kept = 0;
   for (const FrameEvaluation& frame : frames) {
     if (!frame.evaluated) continue;
     rmses.push_back(frame.rmse_mm);
+    flat_rmses.push_back(frame.flat_rmse_mm);
     squared += frame.squared_error_sum;
     kept += frame.points_kept;
   }
   metrics.frames_evaluated = static_cast<int>(rmses.size());
   if (rmses.empty()) return metrics;
   metrics.rmse_mm = Mean(rmses);
+  metrics.rmse_flat_mm = Mean(flat_rmses);
   std::sort(rmses.begin(), rmses.end());
   const size_t n = rmses.size();
   metrics.rmse_median_mm = n % 2 ? rmses[n / 2] : 0.5 * (rmses[n / 2 - 1] + rmses[n / 2]);

@@ -6,6 +6,11 @@
 // comes from trimmed least squares: s = 1, then 10 times: keep the 95 % smallest squared
 // residuals (z_gt − s·z_est)², s ← Σ z_gt·z_est / Σ z_est² over them, RMSE ← √(mean kept
 // squared residual) with the new s. The RMSE is in ground-truth units (mm).
+//
+// Beside it, the flat-map RMSE: the same points and the same rule with every estimate at one
+// depth, which is what a map without any structure scores. A depth estimate carries
+// information only where its RMSE is below that; in a tube most of the RMSE can be the spread
+// of the true depths.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -37,6 +42,7 @@ struct FrameEvaluation {
   double scale = 0.0;      // s: map units → mm
   double rmse_mm = 0.0;
   double squared_error_sum = 0.0;  // over the kept points, for pooled aggregates
+  double flat_rmse_mm = 0.0;       // the same points all at one depth (EvaluateFrame only)
 };
 
 // Bilinear sample of a depth map (CV_32F, 0 = none); nullopt unless all four taps are valid.
@@ -46,7 +52,8 @@ std::optional<double> SampleDepth(const cv::Mat& depth_mm, const cv::Point2d& pi
 FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
                                    const EvaluationOptions& options);
 
-// Samples the ground truth at every point, then EvaluateDepthPairs.
+// Samples the ground truth at every point, then EvaluateDepthPairs, of the estimates and of
+// the flat map.
 FrameEvaluation EvaluateFrame(const std::vector<DepthPoint>& points, const cv::Mat& depth_mm,
                               const EvaluationOptions& options);
 
@@ -55,6 +62,7 @@ struct SequenceMetrics {
   double rmse_mm = 0.0;         // mean of frame RMSEs (the paper's headline)
   double rmse_median_mm = 0.0;
   double rmse_pooled_mm = 0.0;  // √(Σ kept squared errors / Σ kept points) over all frames
+  double rmse_flat_mm = 0.0;    // mean of frame flat-map RMSEs, over the same frames as rmse_mm
   int frames_evaluated = 0;
 };
 SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames);

@@ -149,7 +149,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   points_csv << "frame,point_id,u,v,z_est,x,y,z,status\n";
   std::ofstream metrics_csv = OpenForWriting(out / "metrics.csv");
   metrics_csv << "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,deformable_candidates,new_points,"
-                 "points_without_gt,scale,rmse_mm,ms_klt,ms_pose,ms_deformation,ms_dba,ms_triangulation,ms_total,"
+                 "points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,ms_dba,ms_triangulation,ms_total,"
                  "ms_joint_solve,ms_linear_solve,note\n";
   std::ofstream log = OpenForWriting(out / "run.log");
 
@@ -270,6 +270,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                 << mapping.deformable_candidates << ',' << mapping.new_points << ','
                 << evaluation.points_without_groundtruth << ',' << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
                 << (evaluation.evaluated ? std::to_string(evaluation.rmse_mm) : std::string()) << ','
+                << (evaluation.evaluated ? std::to_string(evaluation.flat_rmse_mm) : std::string()) << ','
                 << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
                 << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation << ','
                 << result.ms_joint_solve << ',' << result.ms_linear_solve << ",\"" << result.note << "\"\n";
@@ -296,6 +297,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.rmse_mm = metrics.rmse_mm;
   summary.rmse_median_mm = metrics.rmse_median_mm;
   summary.rmse_pooled_mm = metrics.rmse_pooled_mm;
+  summary.rmse_flat_mm = metrics.rmse_flat_mm;
   summary.frames_evaluated = metrics.frames_evaluated;
   summary.trajectory_error = AlignedTrajectoryError(aligned_maps);
   const TrajectoryError& trajectory_error = summary.trajectory_error;
@@ -306,6 +308,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary_json << nlohmann::json{{"rmse_mm", summary.rmse_mm},
                                  {"rmse_median_mm", summary.rmse_median_mm},
                                  {"rmse_pooled_mm", summary.rmse_pooled_mm},
+                                 {"rmse_flat_mm", summary.rmse_flat_mm},
                                  {"frames_tracked", summary.frames_tracked},
                                  {"frames_total", summary.frames_total},
                                  {"frames_lost", summary.frames_lost},

@@ -4,8 +4,8 @@
 //   points.csv      frame, point id, u, v, z_est (camera depth, map units), world X Y Z, status
 //   depth/NNNNNN.png  estimated depth: points splatted at their pixels, in mm (frame scale),
 //                   16-bit in the sequence's depth unit, 0 = none
-//   metrics.csv     per frame: state, points, outliers, scale, RMSE, ms per stage
-//   summary.json    rmse_mm, rmse_median_mm, rmse_pooled_mm, frames_tracked, frames_total,
+//   metrics.csv     per frame: state, points, outliers, scale, RMSE, flat-map RMSE, ms per stage
+//   summary.json    rmse_mm, rmse_median_mm, rmse_pooled_mm, rmse_flat_mm, frames_tracked, frames_total,
 //                   init_frame, fps, ms per stage, maps, map_points and the run's status
 //   map.ply         the final map points, coloured
 //   run.log         what happened, in words
@@ -22,6 +22,7 @@ namespace nrslam {
 
 struct RunSummary {
   double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
+  double rmse_flat_mm = 0;  // the same points all at one depth (eval/depth_evaluation.h)
   int frames_tracked = 0;  // frames with a pose after initialisation (the paper's "# Fr.")
   int frames_total = 0;
   int frames_lost = 0;
