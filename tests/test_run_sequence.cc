@@ -24,6 +24,7 @@
 #include "nrslam/io/tum.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
+#include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
 
@@ -214,6 +215,27 @@ TEST_F(RunSequenceTest, StiffDisplacementPriorHoldsThePointsWhereTheyWere) {
   EXPECT_LT(*std::max_element(held.begin(), held.end()), 1e-3);
   // Without the prior the same points follow the tissue (A = 5 mm).
   EXPECT_GT(std::accumulate(free.begin(), free.end(), 0.0) / free.size(), 0.5);
+}
+
+TEST_F(RunSequenceTest, MotionSeedStartsTheSolvesElsewhereAndStillTracks) {
+  SystemOptions options = TrackingExperiment();
+  options.tracking.deformation_motion_seed = true;
+  const RunSummary seeded = RunSequence(*base_ / "sequence", options, *base_ / "seeded");
+  EXPECT_EQ(seeded.frames_tracked, 40);
+  EXPECT_LT(seeded.rmse_mm, 2.0);
+  // The solves are not run to convergence, so a different start gives a different run.
+  EXPECT_NE(seeded.rmse_mm, summary_->rmse_mm);
+}
+
+TEST(MotionSeed, TheCommonMotionIsRemovedAndTheRestKept) {
+  const std::vector<Eigen::Vector3d> relative =
+      WithoutCommonMotion({{1.0, 2.0, 3.0}, {3.0, 2.0, 1.0}, {2.0, 5.0, 2.0}});
+  ASSERT_EQ(relative.size(), 3u);
+  EXPECT_TRUE(relative[0].isApprox(Eigen::Vector3d(-1.0, -1.0, 1.0)));
+  EXPECT_TRUE(relative[1].isApprox(Eigen::Vector3d(1.0, -1.0, -1.0)));
+  EXPECT_TRUE(relative[2].isApprox(Eigen::Vector3d(0.0, 2.0, 0.0)));
+  EXPECT_TRUE(WithoutCommonMotion({{4.0, -1.0, 7.0}})[0].isZero());  // one point: all of it is common
+  EXPECT_TRUE(WithoutCommonMotion({}).empty());
 }
 
 TEST(SystemOptionsNames, UniqueLastNamesResolveToFullPaths) {

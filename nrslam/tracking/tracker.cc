@@ -42,6 +42,15 @@ ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType sol
 
 }  // namespace
 
+std::vector<Eigen::Vector3d> WithoutCommonMotion(std::vector<Eigen::Vector3d> motions) {
+  if (motions.empty()) return motions;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& motion : motions) mean += motion;
+  mean /= static_cast<double>(motions.size());
+  for (Eigen::Vector3d& motion : motions) motion -= mean;
+  return motions;
+}
+
 const char* ToString(TrackingState state) {
   switch (state) {
     case TrackingState::kNotInitialised: return "not_initialised";
@@ -109,6 +118,7 @@ FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv:
   FrameResult result;
   result.frame = frame;
   map_ = std::make_unique<Map>(deformation_);
+  point_motion_.clear();
   tracks_.clear();
   lost_.clear();
   if (static_cast<int>(seed.points.size()) < options_.min_points) {
@@ -267,11 +277,14 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
   }
 }
 
-std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const {
+std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observations,
+                                      const std::vector<Eigen::Vector3d>& start, Rigid3* pose) const {
   const PoseParams seed = pose->ToParams();
   std::vector<bool> inliers(observations.size(), true);
   std::vector<Eigen::Vector3d> points;
-  for (const Observation& o : observations) points.push_back(map_->point(o.id).position);
+  for (size_t i = 0; i < observations.size(); ++i) {
+    points.push_back(map_->point(observations[i].id).position + start[i]);
+  }
   Se3Manifold manifold;
   PoseParams params = seed;
   for (int round = 0; round < options_.pose_rounds; ++round) {
@@ -301,7 +314,8 @@ std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observatio
   return inliers;
 }
 
-Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
+Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation>& observations,
+                                                   const std::vector<Eigen::Vector3d>& start, Rigid3* pose,
                                                    std::vector<Eigen::Vector3d>* displacements,
                                                    std::vector<bool>* inliers) const {
   const size_t n = observations.size();
@@ -328,7 +342,7 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
   // A point the refined pose puts behind the camera (or off the lens) would make every
   // evaluation of the problem fail, and Ceres would return at once: it starts as an outlier.
   inliers->assign(n, true);
-  for (size_t i = 0; i < n; ++i) (*inliers)[i] = camera_.Project(*pose * points[i]).has_value();
+  for (size_t i = 0; i < n; ++i) (*inliers)[i] = camera_.Project(*pose * (points[i] + start[i])).has_value();
   // A viscous term whose residual ended a round beyond the Huber δ sits the next round out:
   // neighbours that really move apart (strong or discontinuous deformation) stop pulling.
   std::vector<bool> viscous_on(pairs.size(), true);
@@ -363,8 +377,8 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
   if (options_.joint_trust_region == "dogleg") solver_options.trust_region_strategy_type = ceres::DOGLEG;
   JointSolveTimes times;
   for (int round = 0; round < options_.deformation_rounds; ++round) {
-    params = rigid;  // every round restarts from the rigid pose and δ = 0
-    displacements->assign(n, Eigen::Vector3d::Zero());
+    params = rigid;  // every round restarts from the rigid pose and the start δ
+    *displacements = start;
     ceres::Problem problem(problem_options);
     problem.AddParameterBlock(params.data(), kPoseParams, &manifold);
     for (size_t i = 0; i < n; ++i) {
@@ -453,7 +467,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   if (static_cast<int>(observations.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(observations.size()) + " points in front of the camera");
   }
-  std::vector<bool> inliers = RefinePose(observations, &pose);
+  std::vector<Eigen::Vector3d> motion_seeds(observations.size(), Eigen::Vector3d::Zero());
+  if (!options_.rigid && options_.deformation_motion_seed) {
+    for (size_t i = 0; i < observations.size(); ++i) {
+      const auto id = static_cast<size_t>(observations[i].id);
+      if (id < point_motion_.size()) motion_seeds[i] = point_motion_[id];  // new points: none yet
+    }
+    motion_seeds = WithoutCommonMotion(std::move(motion_seeds));
+  }
+  std::vector<bool> inliers = RefinePose(observations, motion_seeds, &pose);
   result.ms_pose = MillisecondsSince(pose_start);
 
   // Deformation.
@@ -461,7 +483,11 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
   std::vector<bool> demoted(observations.size(), false);
   if (!options_.rigid) {
-    const JointSolveTimes times = SolveDeformation(observations, &pose, &displacements, &inliers);
+    std::vector<Eigen::Vector3d> before;  // to measure this frame's motion of every point, seeds for the next
+    if (options_.deformation_motion_seed) {
+      for (const MapPoint& point : map_->points()) before.push_back(point.position);
+    }
+    const JointSolveTimes times = SolveDeformation(observations, motion_seeds, &pose, &displacements, &inliers);
     result.ms_joint_solve = times.ms_total;
     result.ms_linear_solve = times.ms_linear;
     // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
@@ -490,6 +516,8 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     }
     map_->graph().UpdatePoints(updated_ids, map_->Positions());
     result.propagated = PropagateMotion(optimised, demoted_ids);
+    point_motion_.resize(before.size());
+    for (size_t id = 0; id < before.size(); ++id) point_motion_[id] = map_->points()[id].position - before[id];
   }
   result.ms_deformation = MillisecondsSince(deformation_start);
 

@@ -61,6 +61,11 @@ struct FrameResult {
   std::string note;                  // why a frame is not tracked
 };
 
+// `motions` less their mean: the part of the points' motion the camera cannot take over. The
+// start of a frame's displacements when `deformation_motion_seed` is on (the camera's
+// constant-velocity seed already carries the common part).
+std::vector<Eigen::Vector3d> WithoutCommonMotion(std::vector<Eigen::Vector3d> motions);
+
 // The map a tracker starts from: 3D points (world) seen at pixels of the start frame.
 struct MapSeed {
   Rigid3 cam_from_world;             // the start frame's camera
@@ -130,6 +135,8 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialised;
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
+  // By point id: how far the last frame's tracking moved it (with deformation_motion_seed).
+  std::vector<Eigen::Vector3d> point_motion_;
   int frames_since_keyframe_ = 0;
   bool candidates_ = false;
   int next_track_id_ = 0;
@@ -141,13 +148,17 @@ class Tracker {
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
-  std::vector<bool> RefinePose(const std::vector<Observation>& observations, Rigid3* pose) const;
+  // Each point is moved by its `start` δ (one per observation) before the fit.
+  std::vector<bool> RefinePose(const std::vector<Observation>& observations, const std::vector<Eigen::Vector3d>& start,
+                               Rigid3* pose) const;
   // Ceres's time in the joint solves of one frame, all rounds.
   struct JointSolveTimes {
     double ms_total = 0, ms_linear = 0;
   };
-  // The joint pose + displacement problem; fills displacements and inlier flags.
-  JointSolveTimes SolveDeformation(const std::vector<Observation>& observations, Rigid3* pose,
+  // The joint pose + displacement problem; fills displacements and inlier flags. Every round
+  // starts from the given pose and `start` (one δ per observation).
+  JointSolveTimes SolveDeformation(const std::vector<Observation>& observations,
+                                   const std::vector<Eigen::Vector3d>& start, Rigid3* pose,
                                    std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
   // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
   // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.

@@ -31,6 +31,13 @@ struct TrackingOptions {
   // reference). Moving the camera and every δ by the same amount changes no other residual,
   // so without a prior nothing but LM damping decides how much of a common motion is the camera's.
   double displacement_prior_sigma = 0.0;
+  // Start each frame's pose refinement and joint solve from the points moved by their motion of
+  // the previous frame, less the mean motion of the tracked points (which the camera's
+  // constant-velocity seed already carries, and which no residual can tell from it).
+  // Only where the solves start changes, not what they minimise (not in the reference).
+  // Measured better when tracking a map from depth (`--no-mapping`), worse with mapping,
+  // where δ also carries corrections to the map (README "Tracking").
+  bool deformation_motion_seed = false;
   // Mid-term re-association: a lost map point is looked for again by a KLT seeded at its
   // projection, with the patch of the keyframe it was last tracked from.
   bool reassociation = true;
@@ -42,7 +49,7 @@ struct TrackingOptions {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
                                                 deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
-                                                displacement_prior_sigma,
+                                                displacement_prior_sigma, deformation_motion_seed,
                                                 reassociation, reassociation_levels, reassociation_gate_px2,
                                                 lost_max_age_frames)
 
