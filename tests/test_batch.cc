@@ -4,6 +4,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -12,6 +14,7 @@
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 #include "nrslam/batch/results_diff.h"
+#include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
 #include "temp_folder.h"
@@ -331,6 +334,94 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
   EXPECT_LT(DiffResults(a, no_ate).mean_ate_b_mm, 0);
 }
 
+TEST(RigidComparison, MeansOverTheFramesBothRunsEvaluated) {
+  const CommonFramesRmse common = MeanOverCommonFrames({{0, 0.0}, {1, 1.0}, {2, 2.0}, {3, 3.0}}, {{0, 0.0}, {1, 3.0}, {2, 1.0}});
+  EXPECT_EQ(common.frames, 3);
+  EXPECT_DOUBLE_EQ(common.a_mm, 1.0);
+  EXPECT_DOUBLE_EQ(common.b_mm, 4.0 / 3.0);
+  const CommonFramesRmse none = MeanOverCommonFrames({{5, 1.0}}, {{6, 1.0}});
+  EXPECT_EQ(none.frames, 0);
+  EXPECT_EQ(none.a_mm, 0.0);
+}
+
+// A finished run as CollectResults reads it, with the per-frame RMSEs its metrics.csv holds
+// (frames without one are written empty, as the runner writes frames it did not track).
+RunResult FinishedRun(const RunJob& run, const std::vector<double>& frame_rmse) {
+  std::ostringstream metrics;
+  metrics << "frame,state,rmse_mm,note\n";
+  RunResult result;
+  result.sequence = run.sequence;
+  result.label = run.label;
+  result.point = run.point;
+  result.status = "ok";
+  result.frames_total = static_cast<int>(frame_rmse.size());
+  for (size_t i = 0; i < frame_rmse.size(); ++i) {
+    const bool tracked = !std::isnan(frame_rmse[i]);
+    metrics << i << ',' << (tracked ? "tracking" : "lost") << ',';
+    if (tracked) {
+      metrics << frame_rmse[i];
+      result.rmse_mm += frame_rmse[i];
+      ++result.frames_evaluated;
+    }
+    metrics << ",\"\"\n";
+  }
+  result.frames_tracked = result.frames_evaluated;
+  result.rmse_mm /= std::max(1, result.frames_evaluated);
+  WriteFile(run.run_folder / "metrics.csv", metrics.str());
+  result.run_folder = run.run_folder.string();
+  return result;
+}
+
+TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
+  const auto folder = UniqueTempFolder("rigid_pairs");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
+      {"name": "a", "preset": "sim-1"},
+      {"name": "b", "preset": "sim-2"},
+      {"name": "a-rigid", "preset": "sim-1", "rigid": true},
+      {"name": "c", "preset": "sim-3", "set": {"k": 2}},
+      {"name": "c-rigid", "preset": "sim-3", "rigid": true},
+      {"name": "d-rigid", "preset": "sim-4", "rigid": true}
+    ]})"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  const double lost = std::nan("");
+  const std::vector<RunResult> results = {
+      FinishedRun(plan.runs[0], {0.0, 1.0, 2.0, 3.0}), FinishedRun(plan.runs[1], {0.0, 1.0, 1.0, 1.0}),
+      FinishedRun(plan.runs[2], {0.0, 0.5, lost, lost}), FinishedRun(plan.runs[3], {0.0, 2.0, 2.0, 2.0}),
+      FinishedRun(plan.runs[4], {0.0, 1.0, 1.0, 1.0}), FinishedRun(plan.runs[5], {0.0, 1.0, 1.0, 1.0})};
+  const std::vector<RigidComparison> comparisons = CompareWithRigid(plan, results);
+  ASSERT_EQ(comparisons.size(), 1u);  // b and d have no partner, c's options differ in k
+  EXPECT_EQ(comparisons[0].deformable.sequence, "a");
+  EXPECT_EQ(comparisons[0].rigid.sequence, "a-rigid");
+  EXPECT_EQ(comparisons[0].common.frames, 2);
+  EXPECT_DOUBLE_EQ(comparisons[0].common.a_mm, 0.5);
+  EXPECT_DOUBLE_EQ(comparisons[0].common.b_mm, 0.25);
+  // Own RMSEs 1.5 and 0.25 (ratio 0.17); over the common frames 0.5 and 0.25 (0.50).
+  const std::vector<std::string> cells = RigidComparisonCells(comparisons[0]);
+  ASSERT_EQ(cells.size(), RigidComparisonHeader().size());
+  EXPECT_EQ(cells[4], "0.17");
+  EXPECT_EQ(cells[5], "4 / 2");
+  EXPECT_EQ(cells[9], "0.50");
+  std::stringstream table;
+  PrintRigidComparison(comparisons, table);
+  EXPECT_NE(table.str().find("a-rigid"), std::string::npos) << table.str();
+  table.str("");
+  PrintRigidComparison({}, table);
+  EXPECT_TRUE(table.str().empty());
+
+  // A sweep of the rigid flag itself pairs each point with its rigid twin.
+  const Manifest one = LoadManifest(WriteFile(folder / "one.json", R"({"sequences": [{"name": "s", "preset": "sim-1"}]})"));
+  const EvaluationPlan swept =
+      PlanEvaluation(one, {}, {ParseSweep("tracking.rigid=false,true")}, folder / "swept", folder / "cache");
+  ASSERT_EQ(swept.runs.size(), 2u);
+  const std::vector<RigidComparison> twins = CompareWithRigid(
+      swept, {FinishedRun(swept.runs[0], {0.0, 1.0}), FinishedRun(swept.runs[1], {0.0, 2.0})});
+  ASSERT_EQ(twins.size(), 1u);
+  EXPECT_EQ(RunKey(twins[0].deformable), "s [rigid=false]");
+  EXPECT_EQ(RunKey(twins[0].rigid), "s [rigid=true]");
+  EXPECT_EQ(RigidComparisonCells(twins[0])[9], "2.00");
+  std::filesystem::remove_all(folder);
+}
+
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   const auto folder = UniqueTempFolder("batch_broken");
   // A sequence folder with an incomplete sequence.json, between two good simulated ones (eight
@@ -367,9 +458,20 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   EXPECT_DOUBLE_EQ(read[0].rmse_flat_mm, results[0].rmse_flat_mm);
   EXPECT_LT(read[1].rmse_flat_mm, 0.0);  // failed: none recorded
 
+  // The rigid run is the good run's baseline; the broken one has none.
+  const std::vector<RigidComparison> comparisons = CompareWithRigid(plan, results);
+  ASSERT_EQ(comparisons.size(), 1u);
+  EXPECT_EQ(comparisons[0].deformable.sequence, "good");
+  EXPECT_EQ(comparisons[0].rigid.sequence, "good-rigid");
+  EXPECT_EQ(comparisons[0].common.frames, std::min(results[0].frames_evaluated, results[2].frames_evaluated));
+  if (results[2].frames_evaluated == results[0].frames_evaluated) {  // the same frames: the runs' own means
+    EXPECT_NEAR(comparisons[0].common.a_mm, results[0].rmse_mm, 1e-6);
+    EXPECT_NEAR(comparisons[0].common.b_mm, results[2].rmse_mm, 1e-6);
+  }
+
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,
   // and the failed sequence is shown as such.
-  WriteReport(results, folder / "out" / "report");
+  WriteReport(results, comparisons, folder / "out" / "report");
   if (std::system("chromium --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "chromium is not installed";
   const std::string dom = (folder / "dom.html").string(), log = (folder / "browser.log").string();
   ASSERT_EQ(std::system(("timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=5000 "
@@ -385,6 +487,7 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=4 series=8\""), std::string::npos)
       << page.substr(0, 2000);
   EXPECT_NE(page.find("Failed: exit code 1"), std::string::npos);
+  EXPECT_NE(page.find("<h2>Deformable against rigid</h2>"), std::string::npos);
   EXPECT_EQ(browser.find("Uncaught"), std::string::npos) << browser;
   std::filesystem::remove_all(folder);
 }

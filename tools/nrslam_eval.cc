@@ -1,6 +1,7 @@
 // nrslam_eval: runs NR-SLAM over every sequence of a manifest (each in its own process),
-// with optional parameter sweeps, prints the results table, writes results.json/.csv, and
-// checks or writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
+// with optional parameter sweeps, prints the results table (and each deformable run beside
+// its rigid baseline, when the manifest has both), writes results.json/.csv, and checks or
+// writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
 // result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere); `nrslam_eval
 // compare RUN_A RUN_B` scores two runs of one sequence on the points both report; `nrslam_eval
 // diff EVAL_A EVAL_B` sets two evaluations of the same runs side by side, run for run.
@@ -15,6 +16,7 @@
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 #include "nrslam/batch/results_diff.h"
+#include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
@@ -31,13 +33,18 @@ nrslam::Programs SiblingPrograms() {
 }
 
 // Exit codes: 0 all well, 1 bad usage or input, 2 some run failed, 3 baseline check failed.
-int Finish(const std::vector<nrslam::RunResult>& results, const std::filesystem::path& out,
-           const std::string& check_baseline, const std::string& write_baseline, double tolerance) {
+int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out, const std::string& check_baseline,
+           const std::string& write_baseline, double tolerance) {
+  const std::vector<nrslam::RunResult> results = nrslam::CollectResults(plan);
+  const std::vector<nrslam::RigidComparison> comparisons = nrslam::CompareWithRigid(plan, results);
   nrslam::WriteResults(results, out);
-  nrslam::WriteReport(results, out / "report");
+  nrslam::WriteRigidComparison(comparisons, out / "rigid_comparison.csv");
+  nrslam::WriteReport(results, comparisons, out / "report");
   std::cout << '\n';
   nrslam::PrintResults(results, std::cout);
+  nrslam::PrintRigidComparison(comparisons, std::cout);
   std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string()
+            << (comparisons.empty() ? "" : ", " + (out / "rigid_comparison.csv").string())
             << "\nreport:  " << (out / "report" / "index.html").string() << '\n';
   int code = 0;
   for (const auto& result : results) code = result.status == "failed" ? 2 : code;
@@ -134,7 +141,7 @@ int main(int argc, char** argv) {
           if (std::filesystem::exists(candidate / "summary.json")) run.run_folder = candidate;
         }
       }
-      return Finish(nrslam::CollectResults(plan), out, check_baseline, write_baseline, tolerance);
+      return Finish(plan, out, check_baseline, write_baseline, tolerance);
     }
     if (manifest_path.empty()) throw nrslam::Error("a manifest is required (see data_manifests/)");
     const nrslam::Manifest manifest = nrslam::LoadManifest(manifest_path);
@@ -155,7 +162,7 @@ int main(int argc, char** argv) {
     // children inherit this; a value the user set is kept.
     if (jobs > 1) setenv("OMP_WAIT_POLICY", "passive", /*overwrite=*/0);
     nrslam::ExecutePlan(plan, programs, jobs, [](const std::string& line) { std::cerr << line << '\n'; });
-    return Finish(nrslam::CollectResults(plan), out, check_baseline, write_baseline, tolerance);
+    return Finish(plan, out, check_baseline, write_baseline, tolerance);
   } catch (const std::exception& e) {
     std::cerr << "nrslam_eval: " << e.what() << '\n';
     return 1;

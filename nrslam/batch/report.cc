@@ -133,6 +133,21 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
 }
 
 // With sweeps: mean RMSE against each swept option's value, one line per sequence.
+// A table of text cells, each escaped.
+std::string HtmlTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows) {
+  std::ostringstream html;
+  html << "<table><tr>";
+  for (const std::string& column : header) html << "<th>" << EscapeXml(column) << "</th>";
+  html << "</tr>\n";
+  for (const std::vector<std::string>& row : rows) {
+    html << "<tr>";
+    for (const std::string& cell : row) html << "<td>" << EscapeXml(cell) << "</td>";
+    html << "</tr>\n";
+  }
+  html << "</table>\n";
+  return html.str();
+}
+
 std::string SweepSection(const std::vector<RunResult>& results) {
   // option → sequence → value → (sum, n): each point averages over the other options' values.
   std::map<std::string, std::map<std::string, std::map<double, std::pair<double, int>>>> curves;
@@ -153,16 +168,11 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   if (summaries.empty()) return "";
   static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"};
   std::ostringstream html;
+  std::vector<std::vector<std::string>> rows;
+  for (const SweepValueSummary& summary : summaries) rows.push_back(SweepSummaryCells(summary));
   html << "<section><h2>Sweeps</h2><p>Per swept value, over the sequences tracked to the end at every point; "
-          "each run is also paired with the run of the same sequence at the option's default.</p><table><tr>";
-  for (const std::string& column : SweepSummaryHeader()) html << "<th>" << EscapeXml(column) << "</th>";
-  html << "</tr>\n";
-  for (const SweepValueSummary& summary : summaries) {
-    html << "<tr>";
-    for (const std::string& cell : SweepSummaryCells(summary)) html << "<td>" << EscapeXml(cell) << "</td>";
-    html << "</tr>\n";
-  }
-  html << "</table>\n";
+          "each run is also paired with the run of the same sequence at the option's default.</p>"
+       << HtmlTable(SweepSummaryHeader(), rows);
   if (curves.empty()) return html.str() + "</section>\n";  // no numeric values to plot against
   html << "<p>RMSE of the runs that tracked every frame against each swept option, "
           "per sequence; with several options swept, each point is the mean over the others' values.</p>"
@@ -183,9 +193,23 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   return html.str();
 }
 
+std::string RigidSection(const std::vector<RigidComparison>& comparisons) {
+  if (comparisons.empty()) return "";
+  std::ostringstream html;
+  html << "<section><h2>Deformable against rigid</h2><p>Each deformable run beside the rigid run of the same "
+          "sequence and options. Ratio = rigid / deformable: above 1, the deformable run is more accurate. "
+          "\"Common\": both runs scored over the frames both evaluated (a rigid run that stops early is "
+          "otherwise scored on the first frames only).</p>";
+  std::vector<std::vector<std::string>> rows;
+  for (const RigidComparison& comparison : comparisons) rows.push_back(RigidComparisonCells(comparison));
+  html << HtmlTable(RigidComparisonHeader(), rows) << "</section>\n";
+  return html.str();
+}
+
 }  // namespace
 
-void WriteReport(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
+void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidComparison>& comparisons,
+                 const std::filesystem::path& folder) {
   std::filesystem::create_directories(folder);
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>nrslam evaluation</title>\n"
@@ -207,7 +231,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::filesystem::p
          << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FlatRmseCell(r) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
-  html << "</table>\n" << SweepSection(results);
+  html << "</table>\n" << SweepSection(results) << RigidSection(comparisons);
   for (const RunResult& r : results) html << RunSection(r, folder);
   // Self-check for people and for the test that opens the page in a headless browser.
   html << "<script>window.addEventListener('load',()=>{const i=[...document.images];"

@@ -1,6 +1,6 @@
 // batch: the HTML report of an evaluation — the results table, and per run its RMSE over
 // time, its trajectory against the ground truth (top view), and depth-error images of a few
-// frames; with sweeps, RMSE against each swept option. One folder, no scripts from the
+// frames; with sweeps, RMSE against each swept option; deformable runs beside their rigid baselines. One folder, no scripts from the
 // network: it opens offline and can be archived with the results.
 #pragma once
 
@@ -8,11 +8,14 @@
 #include <vector>
 
 #include "nrslam/batch/results.h"
+#include "nrslam/batch/rigid_comparison.h"
 
 namespace nrslam {
 
 // Writes `folder`/index.html and its images. A run whose folder or sequence cannot be read
-// gets a note in the page instead of its plots; the report is still written.
-void WriteReport(const std::vector<RunResult>& results, const std::filesystem::path& folder);
+// gets a note in the page instead of its plots; the report is still written. `comparisons`
+// (CompareWithRigid's, may be empty) get a table of their own.
+void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidComparison>& comparisons,
+                 const std::filesystem::path& folder);
 
 }  // namespace nrslam

@@ -13,7 +13,6 @@
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
-namespace {
 
 std::string CsvField(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
@@ -21,6 +20,8 @@ std::string CsvField(const std::string& text) {
   for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
   return quoted + "\"";
 }
+
+namespace {
 
 // The figures a run's summary.json and a results.json row share, under the same keys.
 void ReadFigures(const Json& json, RunResult* result) {

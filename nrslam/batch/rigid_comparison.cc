@@ -1,0 +1,121 @@
+#include "nrslam/batch/rigid_comparison.h"
+
+#include <cmath>
+#include <fstream>
+
+#include "nrslam/batch/run_folder.h"
+#include "nrslam/util/error.h"
+#include "nrslam/util/text_table.h"
+
+namespace nrslam {
+namespace {
+
+// What makes two runs a deformable run and its rigid baseline: the sequence and every option
+// but `tracking.rigid`.
+std::string BaselineKey(const RunJob& run) {
+  Json options = run.options;
+  options["tracking"]["rigid"] = false;
+  return run.sequence_folder.string() + '\n' + options.dump();
+}
+
+bool IsRigid(const RunJob& run) { return run.options.at("tracking").at("rigid").get<bool>(); }
+
+std::string Ratio(double rigid_mm, double deformable_mm) {
+  return deformable_mm > 0 ? FormatFixed(rigid_mm / deformable_mm, 2) : "-";
+}
+
+}  // namespace
+
+std::map<int, double> ReadFrameRmse(const std::filesystem::path& run_folder) {
+  std::map<int, double> rmse;
+  for (const auto& row : ReadCsv(run_folder / "metrics.csv")) {
+    const double frame = Number(row, "frame"), value = Number(row, "rmse_mm");
+    if (!std::isnan(frame) && !std::isnan(value)) rmse[static_cast<int>(frame)] = value;
+  }
+  return rmse;
+}
+
+CommonFramesRmse MeanOverCommonFrames(const std::map<int, double>& a, const std::map<int, double>& b) {
+  CommonFramesRmse common;
+  for (const auto& [frame, a_mm] : a) {
+    const auto found = b.find(frame);
+    if (found == b.end()) continue;
+    ++common.frames;
+    common.a_mm += a_mm;
+    common.b_mm += found->second;
+  }
+  if (common.frames > 0) {
+    common.a_mm /= common.frames;
+    common.b_mm /= common.frames;
+  }
+  return common;
+}
+
+std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const std::vector<RunResult>& results) {
+  if (results.size() != plan.runs.size()) throw Error("rigid comparison: results do not match the plan's runs");
+  std::map<std::string, size_t> rigid_runs;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (IsRigid(plan.runs[i]) && results[i].status != "failed" && results[i].evaluated()) {
+      rigid_runs.emplace(BaselineKey(plan.runs[i]), i);  // the first one of a key stays
+    }
+  }
+  std::vector<RigidComparison> comparisons;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (IsRigid(plan.runs[i]) || results[i].status == "failed" || !results[i].evaluated()) continue;
+    const auto rigid = rigid_runs.find(BaselineKey(plan.runs[i]));
+    if (rigid == rigid_runs.end()) continue;
+    RigidComparison comparison{results[i], results[rigid->second], {}};
+    try {
+      comparison.common = MeanOverCommonFrames(ReadFrameRmse(plan.runs[i].run_folder),
+                                               ReadFrameRmse(plan.runs[rigid->second].run_folder));
+    } catch (const Error&) {
+      // A run folder without metrics.csv (e.g. merged from elsewhere without it): no common frames.
+    }
+    comparisons.push_back(comparison);
+  }
+  return comparisons;
+}
+
+std::vector<std::string> RigidComparisonHeader() {
+  return {"deformable run", "rigid run",     "def mm",        "rigid mm",        "ratio",
+          "tracked def / rigid", "common frames", "def mm common", "rigid mm common", "ratio common"};
+}
+
+std::vector<std::string> RigidComparisonCells(const RigidComparison& c) {
+  const bool common = c.common.frames > 0;
+  return {RunKey(c.deformable),
+          RunKey(c.rigid),
+          FormatFixed(c.deformable.rmse_mm, 3),
+          FormatFixed(c.rigid.rmse_mm, 3),
+          Ratio(c.rigid.rmse_mm, c.deformable.rmse_mm),
+          std::to_string(c.deformable.frames_tracked) + " / " + std::to_string(c.rigid.frames_tracked),
+          std::to_string(c.common.frames),
+          common ? FormatFixed(c.common.a_mm, 3) : "-",
+          common ? FormatFixed(c.common.b_mm, 3) : "-",
+          common ? Ratio(c.common.b_mm, c.common.a_mm) : "-"};
+}
+
+void PrintRigidComparison(const std::vector<RigidComparison>& comparisons, std::ostream& out) {
+  if (comparisons.empty()) return;
+  out << "\nDeformable against rigid: the same sequence and options but tracking.rigid. Ratio = rigid / deformable\n"
+         "RMSE, above 1 where the deformable run is more accurate; \"common\": both over the frames both evaluated.\n";
+  TextTable table(RigidComparisonHeader());
+  for (const RigidComparison& c : comparisons) table.AddRow(RigidComparisonCells(c));
+  table.Print(out);
+}
+
+void WriteRigidComparison(const std::vector<RigidComparison>& comparisons, const std::filesystem::path& file) {
+  std::ofstream csv(file);
+  csv << "deformable_run,rigid_run,deformable_rmse_mm,rigid_rmse_mm,deformable_frames_tracked,rigid_frames_tracked,"
+         "frames_total,common_frames,deformable_common_rmse_mm,rigid_common_rmse_mm\n";
+  for (const RigidComparison& c : comparisons) {
+    csv << CsvField(RunKey(c.deformable)) << ',' << CsvField(RunKey(c.rigid)) << ',' << c.deformable.rmse_mm << ','
+        << c.rigid.rmse_mm << ',' << c.deformable.frames_tracked << ',' << c.rigid.frames_tracked << ','
+        << c.deformable.frames_total << ',' << c.common.frames << ',';
+    if (c.common.frames > 0) csv << c.common.a_mm << ',' << c.common.b_mm;
+    else csv << ',';
+    csv << '\n';
+  }
+}
+
+}  // namespace nrslam
