@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -560,6 +561,26 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   for (const RunResult& result : CollectResults(plan)) {
     EXPECT_EQ(result.status, "failed");
     EXPECT_NE(result.error.find("cannot start"), std::string::npos) << result.error;
+  }
+  std::filesystem::remove_all(folder);
+}
+
+TEST(BatchEvaluation, ARunThatHangsIsKilledAtItsTimeoutAndRecorded) {
+  const auto folder = UniqueTempFolder("batch_timeout");
+  const std::filesystem::path hanger = WriteFile(folder / "hang.sh", "#!/bin/sh\necho waiting forever\nexec sleep 600\n");
+  std::filesystem::permissions(hanger, std::filesystem::perms::owner_all);
+  WriteFile(folder / "seq" / "sequence.json", "{}");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
+    {"name": "a", "path": "seq"}, {"name": "b", "path": "seq"}, {"name": "c", "path": "seq"}]})"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  const auto start = std::chrono::steady_clock::now();
+  ExecutePlan(plan, Programs{kPrograms.simulate, hanger, kPrograms.import}, 2, [](const std::string&) {}, 0.5);
+  // Three runs of 0.5 s, two at a time: about a second, not the 600 s each would take.
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
+  for (const RunResult& result : CollectResults(plan)) {
+    EXPECT_EQ(result.status, "failed");
+    EXPECT_NE(result.error.find("timed out after 0.5 s (killed)"), std::string::npos) << result.error;
+    EXPECT_NE(result.error.find("waiting forever"), std::string::npos) << result.error;  // its last words
   }
   std::filesystem::remove_all(folder);
 }

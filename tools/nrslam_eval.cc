@@ -86,12 +86,17 @@ int main(int argc, char** argv) {
   std::vector<std::string> assignments, sweeps;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   double tolerance = 0.10;
+  double run_timeout = 0;
   app.add_option("manifest", manifest_path, "manifest JSON (see data_manifests/)");
   app.add_option("--out", out, "result folder: runs/<sequence>[/<sweep point>], results.json, results.csv")
       ->capture_default_str();
   app.add_option("--cache", cache, "where presets are rendered and datasets imported, shared between evaluations")
       ->capture_default_str();
   app.add_option("--jobs,-j", jobs, "processes at once")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--timeout", run_timeout, "seconds (wall clock) a run may take before it is killed and recorded as "
+                                           "failed, so a run that hangs cannot stall the batch; 0: no limit")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--config", config_path, "JSON options for every sequence (a run's config.json or an options "
                                           "object): those that differ from the defaults, before --set");
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");
@@ -161,7 +166,8 @@ int main(int argc, char** argv) {
     // needs (two sim runs side by side: 10.3 / 10.0 fps spinning, 13.7 / 14.8 passive). The
     // children inherit this; a value the user set is kept.
     if (jobs > 1) setenv("OMP_WAIT_POLICY", "passive", /*overwrite=*/0);
-    nrslam::ExecutePlan(plan, programs, jobs, [](const std::string& line) { std::cerr << line << '\n'; });
+    nrslam::ExecutePlan(
+        plan, programs, jobs, [](const std::string& line) { std::cerr << line << '\n'; }, run_timeout);
     return Finish(plan, out, check_baseline, write_baseline, tolerance);
   } catch (const std::exception& e) {
     std::cerr << "nrslam_eval: " << e.what() << '\n';

@@ -194,7 +194,7 @@ bool RunIsFinished(const RunJob& run) {
 }
 
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
-                 const std::function<void(const std::string&)>& progress) {
+                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds) {
   // Sequences first: several runs may share one.
   std::vector<Command> prepares;
   std::vector<size_t> prepare_index;
@@ -243,7 +243,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
       continue;
     }
     std::filesystem::create_directories(run.run_folder.parent_path());
-    Command command{{programs.run.string()}, run.run_folder.string() + ".log"};
+    Command command{{programs.run.string()}, run.run_folder.string() + ".log", run_timeout_seconds};
     command.argv.insert(command.argv.end(), run.arguments.begin(), run.arguments.end());
     runs.push_back(command);
     run_index.push_back(i);

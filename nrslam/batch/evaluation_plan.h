@@ -69,8 +69,10 @@ bool RunIsFinished(const RunJob& run);
 
 // Prepares what is missing, then runs what is not finished, `jobs` processes at a time.
 // `progress` gets one line per finished step. Failures are recorded in the run folders
-// (failure.json), never thrown.
+// (failure.json), never thrown. A run still going after `run_timeout_seconds` (wall clock;
+// 0: no limit) is killed and recorded as failed, so one sequence that hangs cannot stall a
+// batch; it is run again by the next evaluation into the same folder.
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
-                 const std::function<void(const std::string&)>& progress);
+                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds = 0);
 
 }  // namespace nrslam

@@ -4,9 +4,13 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <chrono>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <map>
+#include <sstream>
+#include <thread>
 
 extern char** environ;
 
@@ -14,6 +18,11 @@ namespace nrslam {
 
 std::string ProcessOutcome::Describe() const {
   if (!error.empty()) return error;
+  if (timed_out_after_seconds > 0) {
+    std::ostringstream text;
+    text << "timed out after " << timed_out_after_seconds << " s (killed)";
+    return text.str();
+  }
   if (signal != 0) return "killed by signal " + std::to_string(signal) + " (" + strsignal(signal) + ")";
   return "exit code " + std::to_string(exit_code);
 }
@@ -49,8 +58,13 @@ pid_t Start(const Command& command, std::string* error) {
 
 std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
                                         const std::function<void(size_t, const ProcessOutcome&)>& done) {
+  using Clock = std::chrono::steady_clock;
+  struct Running {
+    size_t index;
+    Clock::time_point deadline;  // Clock::time_point::max() without a timeout
+  };
   std::vector<ProcessOutcome> outcomes(commands.size());
-  std::map<pid_t, size_t> running;
+  std::map<pid_t, Running> running;
   size_t next = 0;
   const size_t limit = static_cast<size_t>(std::max(1, jobs));
   while (next < commands.size() || !running.empty()) {
@@ -59,26 +73,44 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
       if (pid < 0) {
         if (done) done(next, outcomes[next]);
       } else {
-        running[pid] = next;
+        const double timeout = commands[next].timeout_seconds;
+        const Clock::time_point deadline =
+            timeout > 0 ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout))
+                        : Clock::time_point::max();
+        running[pid] = {next, deadline};
       }
       ++next;
     }
     if (running.empty()) continue;
+    bool any_deadline = false;
+    for (const auto& [pid, child] : running) any_deadline |= child.deadline != Clock::time_point::max();
     int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
+    // With a deadline to watch, poll (every 20 ms) instead of blocking until a child ends.
+    const pid_t pid = waitpid(-1, &status, any_deadline ? WNOHANG : 0);
+    if (pid == 0) {
+      const Clock::time_point now = Clock::now();
+      for (auto& [child_pid, child] : running) {
+        ProcessOutcome& outcome = outcomes[child.index];
+        if (now < child.deadline || outcome.timed_out_after_seconds > 0) continue;
+        outcome.timed_out_after_seconds = commands[child.index].timeout_seconds;
+        kill(child_pid, SIGKILL);  // reaped by waitpid like any other ending
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
     if (pid < 0) {
       if (errno == EINTR) continue;
       // No children left to wait for although we think some run: record and stop waiting.
-      for (const auto& [lost_pid, index] : running) outcomes[index].error = "lost track of the child process";
+      for (const auto& [lost_pid, child] : running) outcomes[child.index].error = "lost track of the child process";
       running.clear();
       continue;
     }
     const auto found = running.find(pid);
     if (found == running.end()) continue;
-    ProcessOutcome& outcome = outcomes[found->second];
+    const size_t index = found->second.index;
+    ProcessOutcome& outcome = outcomes[index];
     if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
     if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
-    const size_t index = found->second;
     running.erase(found);
     if (done) done(index, outcome);
   }

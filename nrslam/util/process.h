@@ -15,14 +15,17 @@ namespace nrslam {
 struct Command {
   std::vector<std::string> argv;  // argv[0] is the program's path
   std::filesystem::path log;      // receives the child's stdout and stderr (truncated first)
+  double timeout_seconds = 0;     // wall clock after which the child is killed (SIGKILL); 0: none
 };
 
 struct ProcessOutcome {
   int exit_code = -1;  // when the child exited
   int signal = 0;      // when a signal ended it
   std::string error;   // when it could not be started
-  bool ok() const { return error.empty() && signal == 0 && exit_code == 0; }
-  // "exit code 1", "killed by signal 11 (Segmentation fault)", or the start error.
+  double timed_out_after_seconds = 0;  // when it was killed for running past its timeout
+  bool ok() const { return error.empty() && signal == 0 && exit_code == 0 && timed_out_after_seconds == 0; }
+  // "exit code 1", "killed by signal 11 (Segmentation fault)", "timed out after 60 s (killed)",
+  // or the start error.
   std::string Describe() const;
 };
 
