@@ -542,14 +542,23 @@ TEST(BatchEvaluation, ImportedDatasetsRunAndAMissingOneIsReported) {
 
 // A runner that crashes (here: a stand-in that kills itself with SIGSEGV) or cannot be
 // started is a recorded failure of that run, with the reason; the batch finishes.
+// A script standing in for nrslam_run in `folder`, and a plan of `runs` runs for it to fail.
+std::filesystem::path StandInRunner(const std::filesystem::path& folder, const std::string& script, int runs,
+                                    EvaluationPlan* plan) {
+  const std::filesystem::path runner = WriteFile(folder / "runner.sh", "#!/bin/sh\n" + script);
+  std::filesystem::permissions(runner, std::filesystem::perms::owner_all);
+  WriteFile(folder / "seq" / "sequence.json", "{}");
+  std::string sequences;
+  for (int i = 0; i < runs; ++i) sequences += std::string(i ? "," : "") + R"({"name": "r)" + std::to_string(i) + R"(", "path": "seq"})";
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [)" + sequences + "]}"));
+  *plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  return runner;
+}
+
 TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   const auto folder = UniqueTempFolder("batch_crash");
-  const std::filesystem::path crasher = WriteFile(folder / "crash.sh", "#!/bin/sh\necho about to crash\nkill -SEGV $$\n");
-  std::filesystem::permissions(crasher, std::filesystem::perms::owner_all);
-  WriteFile(folder / "seq" / "sequence.json", "{}");
-  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
-    {"name": "a", "path": "seq"}, {"name": "b", "path": "seq"}]})"));
-  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  EvaluationPlan plan;
+  const std::filesystem::path crasher = StandInRunner(folder, "echo about to crash\nkill -SEGV $$\n", 2, &plan);
   ExecutePlan(plan, Programs{kPrograms.simulate, crasher, kPrograms.import}, 2, [](const std::string&) {});
   for (const RunResult& result : CollectResults(plan)) {
     EXPECT_EQ(result.status, "failed");
@@ -567,12 +576,8 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
 
 TEST(BatchEvaluation, ARunThatHangsIsKilledAtItsTimeoutAndRecorded) {
   const auto folder = UniqueTempFolder("batch_timeout");
-  const std::filesystem::path hanger = WriteFile(folder / "hang.sh", "#!/bin/sh\necho waiting forever\nexec sleep 600\n");
-  std::filesystem::permissions(hanger, std::filesystem::perms::owner_all);
-  WriteFile(folder / "seq" / "sequence.json", "{}");
-  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
-    {"name": "a", "path": "seq"}, {"name": "b", "path": "seq"}, {"name": "c", "path": "seq"}]})"));
-  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  EvaluationPlan plan;
+  const std::filesystem::path hanger = StandInRunner(folder, "echo waiting forever\nexec sleep 600\n", 3, &plan);
   const auto start = std::chrono::steady_clock::now();
   ExecutePlan(plan, Programs{kPrograms.simulate, hanger, kPrograms.import}, 2, [](const std::string&) {}, 0.5);
   // Three runs of 0.5 s, two at a time: about a second, not the 600 s each would take.
