@@ -187,6 +187,32 @@ TEST(Results, RunsWithoutGroundTruthShowNoRmse) {
   EXPECT_EQ(ResultsFromJson(old)[0].frames_evaluated, 42);
 }
 
+TEST(Results, WhereAndWhyARunStoppedIsShownAndKept) {
+  RunResult lost = Result("sim-6-rigid", 0.25, 3);
+  lost.status = "lost";
+  lost.stop_frame = 3;
+  lost.stop_reason = "only 7 points left after outlier rejection";
+  RunResult waiting = Result("still", 0.0, 0);
+  waiting.status = "lost";
+  waiting.init_frame = -1;
+  waiting.stop_reason = "initialising: 100 % low parallax";
+  const RunResult fine = Result("sim-0", 0.1, 60);
+  std::stringstream table;
+  PrintResults({lost, waiting, fine}, table);
+  EXPECT_NE(table.str().find("sim-6-rigid: lost from frame 3: only 7 points left after outlier rejection"),
+            std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("still: never initialised: initialising: 100 % low parallax"), std::string::npos)
+      << table.str();
+  EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
+  const std::vector<RunResult> read = ResultsFromJson(ToJson({lost, waiting, fine}));
+  EXPECT_EQ(read[0].stop_frame, 3);
+  EXPECT_EQ(read[0].stop_reason, lost.stop_reason);
+  EXPECT_EQ(read[1].stop_frame, -1);
+  EXPECT_EQ(read[1].stop_reason, waiting.stop_reason);
+  EXPECT_TRUE(read[2].stop_reason.empty());
+  EXPECT_TRUE(ToJson({fine})["results"][0]["stop_reason"].is_null());
+}
+
 // One run of a (k, D) sweep grid, evaluated on 100 frames.
 RunResult GridRun(const std::string& sequence, const std::string& k, const std::string& d, bool lost, double rmse_mm) {
   RunResult r;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <omp.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <cmath>
@@ -574,6 +575,8 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   EXPECT_EQ(monocular.init_frame, -1);
   EXPECT_EQ(monocular.frames_tracked, 0);
   EXPECT_EQ(monocular.frames_total, 2);
+  EXPECT_EQ(monocular.Status(), "not_initialised");
+  EXPECT_EQ(monocular.stop_reason.rfind("initialising: ", 0), 0u) << monocular.stop_reason;
   fs::remove_all(folder);
 }
 
@@ -602,6 +605,30 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
     EXPECT_EQ(fs::exists(folder / "run" / "depth" / FrameFileName(frame)), frame != 6) << frame;
   }
   EXPECT_NE(rows[7].find("000006.png"), std::string::npos) << rows[7];
+  EXPECT_EQ(summary.Status(), "ok");  // tracking again after the bad frame
+  EXPECT_EQ(summary.stop_frame, -1);
+  EXPECT_TRUE(ReadJsonFile(folder / "run" / "summary.json").at("stop_reason").is_null());
+  fs::remove_all(folder);
+}
+
+// A view that goes black (the light off, the lens covered) loses the track on its first black
+// frame: no patch is matched on a flat image. The summary says where and why.
+TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {
+  const fs::path folder = UniqueTempFolder("nrslam_black_end");
+  fs::remove_all(folder);
+  SimulateSmall("sim-0", 10, 320, 240, folder);
+  for (int frame = 7; frame < 10; ++frame) {
+    cv::imwrite((folder / "rgb" / FrameFileName(frame)).string(), cv::Mat::zeros(240, 320, CV_8UC3));
+  }
+  const RunSummary stopped = RunSequence(folder, TrackingExperiment(), folder / "stopped");
+  EXPECT_EQ(stopped.frames_tracked, 7);
+  EXPECT_EQ(stopped.Status(), "lost");
+  EXPECT_EQ(stopped.stop_frame, 7);
+  EXPECT_NE(stopped.stop_reason.find("points tracked"), std::string::npos) << stopped.stop_reason;
+  const Json written = ReadJsonFile(folder / "stopped" / "summary.json");
+  EXPECT_EQ(written.at("status"), "lost");
+  EXPECT_EQ(written.at("stop_frame"), 7);
+  EXPECT_EQ(written.at("stop_reason"), stopped.stop_reason);
   fs::remove_all(folder);
 }
 

@@ -46,7 +46,10 @@ int main(int argc, char** argv) {
       std::cout << "no ground truth, no RMSE  ";
     }
     if (summary.trajectory_error.evaluated) std::cout << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
-    std::cout << summary.fps << " fps\nrun folder: " << out << '\n';
+    std::cout << summary.fps << " fps\n";
+    if (summary.Status() == "not_initialised") std::cout << "never initialised: " << summary.stop_reason << '\n';
+    if (summary.Status() == "lost") std::cout << "lost from frame " << summary.stop_frame << ": " << summary.stop_reason << '\n';
+    std::cout << "run folder: " << out << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_run: " << e.what() << '\n';
     return 1;

@@ -81,6 +81,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
        << "; a map at one depth: " << FlatRmseCell(result) << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
+  if (!StopText(result).empty()) html << "<p>Ended without tracking: " << EscapeXml(StopText(result)) << "</p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
     const Json config = ReadJsonFile(run / "config.json");

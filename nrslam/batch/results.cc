@@ -37,6 +37,11 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->fps = json.value("fps", 0.0);
   const auto ate = json.find("ate_rmse_mm");
   result->ate_mm = ate != json.end() && ate->is_number() ? ate->get<double>() : -1.0;
+  const auto reason = json.find("stop_reason");
+  if (reason != json.end() && reason->is_string()) {
+    result->stop_reason = reason->get<std::string>();
+    result->stop_frame = result->init_frame < 0 ? -1 : json.value("stop_frame", -1);
+  }
 }
 
 // Sequence -> whether every run of it (every sweep point) tracked to the end with ground truth.
@@ -93,6 +98,12 @@ std::string RmseChangeCounts::ToString() const {
   return std::to_string(better) + " / " + std::to_string(same) + " / " + std::to_string(worse);
 }
 
+std::string StopText(const RunResult& result) {
+  if (result.status == "failed" || result.stop_reason.empty()) return "";
+  if (result.init_frame < 0) return "never initialised: " + result.stop_reason;
+  return "lost from frame " + std::to_string(result.stop_frame) + ": " + result.stop_reason;
+}
+
 std::string RmseCell(const RunResult& result, double rmse_mm) {
   return result.evaluated() ? FormatFixed(rmse_mm, 3) : "no GT";
 }
@@ -135,7 +146,9 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
                     {"rmse_flat_mm", r.rmse_flat_mm >= 0 ? Json(r.rmse_flat_mm) : Json()},
-                    {"ate_rmse_mm", r.ate_mm >= 0 ? Json(r.ate_mm) : Json()}, {"fps", r.fps}, {"run_folder", r.run_folder}});
+                    {"ate_rmse_mm", r.ate_mm >= 0 ? Json(r.ate_mm) : Json()}, {"fps", r.fps}, {"run_folder", r.run_folder},
+                    {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
+                    {"stop_reason", r.stop_reason.empty() ? Json() : Json(r.stop_reason)}});
   }
   return {{"results", rows}};
 }
@@ -204,6 +217,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   table.Print(out);
   for (const RunResult& r : results) {
     if (r.status == "failed") out << "FAILED " << RunKey(r) << ": " << r.error << '\n';
+    if (!StopText(r).empty()) out << RunKey(r) << ": " << StopText(r) << '\n';
   }
   if (!swept) return;
   const std::vector<SweepValueSummary> values = SummariseSweep(results);

@@ -24,6 +24,10 @@ struct RunResult {
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
   double rmse_flat_mm = -1;         // what a map at one depth scores on the same points; negative: not recorded
   std::string run_folder;
+  // A run that ends without tracking: from which frame, and why (the runner's note); for a run
+  // that never initialised, frame -1 and the last frame's note. Empty when it ends tracking.
+  int stop_frame = -1;
+  std::string stop_reason;
   bool evaluated() const { return frames_evaluated > 0; }
   // Tracked to the end with ground truth: the runs whose RMSEs compare like with like.
   bool complete() const { return status == "ok" && evaluated(); }
@@ -45,6 +49,9 @@ struct RmseChangeCounts {
   double SignTestP() const;
 };
 
+// Where and why a run that ends without tracking stopped: "lost from frame 12: only 7 points
+// left after outlier rejection" or "never initialised: …"; "" when it ends tracking or failed.
+std::string StopText(const RunResult& result);
 // An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
 std::string RmseCell(const RunResult& result, double rmse_mm);
 // A run's flat-map RMSE as a table shows it: "-" for results written before it was recorded.
@@ -87,7 +94,9 @@ std::vector<std::string> SweepSummaryHeader();
 std::vector<std::string> SweepSummaryCells(const SweepValueSummary& summary);
 
 // The table a person reads: sequence, [sweep point], status, init frame, tracked/total,
-// RMSE mean and median (mm), trajectory error (mm), fps. With sweeps, also SummariseSweep's table.
+// RMSE mean and median (mm), trajectory error (mm), fps; under it why each failed run failed
+// and where and why each run that ends without tracking stopped. With sweeps, also
+// SummariseSweep's table.
 void PrintResults(const std::vector<RunResult>& results, std::ostream& out);
 
 // A regression baseline: per run key (sequence [label]), RMSE and frames tracked, plus the

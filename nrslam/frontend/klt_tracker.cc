@@ -214,8 +214,8 @@ KltTracker::Photometric KltTracker::FitFromSums(size_t slot, const WindowSums& s
 KltTracker::Photometric KltTracker::FitTrend(size_t slot, const Trend& current) const {
   const Trend& reference = reference_trend_[slot];
   Photometric fit;
-  fit.gain = current.deviation > 1e-3 ? std::clamp(static_cast<float>(reference.deviation / current.deviation), 0.2f, 5.f)
-                                      : 1.f;
+  fit.textured = current.deviation > 1e-3;
+  fit.gain = fit.textured ? std::clamp(static_cast<float>(reference.deviation / current.deviation), 0.2f, 5.f) : 1.f;
   fit.bias = static_cast<float>(reference.mean - fit.gain * current.mean);
   fit.slope_u = static_cast<float>(reference.slope_u - fit.gain * current.slope_u);
   fit.slope_v = static_cast<float>(reference.slope_v - fit.gain * current.slope_v);
@@ -461,7 +461,7 @@ KltResult KltTracker::TrackFrom(const ImagePyramid& current, size_t index, const
   result.gain = fit.gain;
   result.bias = fit.bias;
   result.ssim = Ssim(patch, warped, area_);
-  result.status = result.ssim >= ssim_threshold ? KltStatus::kTracked : KltStatus::kSsimRejected;
+  result.status = fit.textured && result.ssim >= ssim_threshold ? KltStatus::kTracked : KltStatus::kSsimRejected;
   return result;
 }
 

@@ -79,6 +79,10 @@ class KltTracker {
 
   struct Photometric {
     float gain = 1.f, bias = 0.f, slope_u = 0.f, slope_v = 0.f;
+    // The window has texture of its own (something left after its linear trend). A flat window
+    // (a black or saturated frame) is corrected into the reference's own trend plane, which
+    // the SSIM would take for a match, so it cannot confirm a track.
+    bool textured = true;
   };
   // The appearance the photometric fit absorbs is spanned by 1, u, v and the patch; these
   // remove it from a steepest-descent image (project-out).

@@ -120,6 +120,11 @@ class FrameIo {
 
 }  // namespace
 
+std::string RunSummary::Status() const {
+  if (init_frame < 0) return "not_initialised";
+  return stop_frame >= 0 ? "lost" : "ok";
+}
+
 RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, const fs::path& out,
                        const RunProgress& progress) {
   options.Check();
@@ -264,6 +269,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     } else if (summary.init_frame >= 0) {
       ++summary.frames_lost;
     }
+    if (tracked) {
+      summary.stop_frame = -1;
+      summary.stop_reason.clear();
+    } else if (summary.stop_frame < 0 || summary.init_frame < 0) {
+      // Where the final untracked stretch began; before any map, the latest reason is the one that matters.
+      if (summary.stop_frame < 0) summary.stop_frame = frame;
+      summary.stop_reason = result.note;
+    }
     metrics_csv << frame << ',' << ToString(result.state) << ',' << maps << ',' << result.points.size() << ','
                 << result.klt_tracked << ',' << result.candidates.size() << ',' << result.outliers << ','
                 << result.propagated << ',' << result.reassociated << ',' << mapping.rigid_candidates << ','
@@ -329,7 +342,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                                  {"init", options.run.init},
                                  {"mapping", options.run.mapping},
                                  {"mode", options.tracking.rigid ? "rigid" : "deformable"},
-                                 {"status", summary.init_frame < 0 ? "not_initialised" : "ok"}}
+                                 {"status", summary.Status()},
+                                 {"stop_frame", summary.stop_frame >= 0 ? nlohmann::json(summary.stop_frame) : nlohmann::json()},
+                                 {"stop_reason", summary.stop_frame >= 0 ? nlohmann::json(summary.stop_reason) : nlohmann::json()}}
                       .dump(2)
                << '\n';
   return summary;

@@ -35,6 +35,12 @@ struct RunSummary {
   TrajectoryError trajectory_error;  // camera centres aligned to the ground-truth poses per map
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
+  // A run that ends without tracking: the first frame of that final stretch and its note (why
+  // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.
+  int stop_frame = -1;
+  std::string stop_reason;
+  // "ok", "lost" (the run ends without tracking) or "not_initialised".
+  std::string Status() const;
 };
 
 using RunProgress = std::function<void(int frame, int total, const std::string& line)>;
