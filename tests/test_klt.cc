@@ -156,6 +156,27 @@ TEST_F(KltOnWarps, SsimRejectsPatchesTrackedOntoTheWrongPlace) {
             static_cast<long>(n));
 }
 
+// A black frame (a flat window) confirms no track. Sensor noise on black does confirm some
+// under the SSIM alone; the texture-correlation gate rejects them and keeps correct matches.
+TEST_F(KltOnWarps, FlatAndNoiseFramesConfirmNoTrack) {
+  const auto tracked_into = [&](const cv::Mat& image, const KltOptions& options) {
+    KltTracker tracker(options);
+    tracker.SetReference(ImagePyramid(*reference_, options.levels), *points_);
+    std::vector<KltResult> results;
+    tracker.Track(ImagePyramid(image, options.levels), *points_, options.ssim_tracking, &results);
+    return std::count_if(results.begin(), results.end(), [](const KltResult& r) { return r.status == KltStatus::kTracked; });
+  };
+  const KltOptions plain;
+  EXPECT_EQ(tracked_into(cv::Mat::zeros(reference_->size(), CV_8UC1), plain), 0);
+  cv::Mat noise(reference_->size(), CV_8UC1);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::NORMAL, 3, 2);
+  KltOptions gated;
+  gated.min_texture_correlation = 0.3;
+  EXPECT_EQ(tracked_into(noise, gated), 0) << tracked_into(noise, plain) << " pass without the gate";
+  EXPECT_EQ(tracked_into(*reference_, gated), static_cast<long>(points_->size()));
+}
+
 TEST(Klt, RejectsBadInputCleanly) {
   const cv::Mat flat(120, 160, CV_8UC1, cv::Scalar(90));
   KltTracker tracker{KltOptions{}};

@@ -25,6 +25,8 @@ void KltOptions::Check() const {
   for (double ssim : {ssim_tracking, ssim_initialisation, ssim_reassociation}) {
     CheckOption(ssim >= -1 && ssim <= 1, "klt", "SSIM thresholds must be in [-1, 1]");
   }
+  CheckOption(min_texture_correlation >= -1 && min_texture_correlation <= 1, "klt",
+              "min_texture_correlation must be in [-1, 1] (-1: off)");
 }
 
 }  // namespace nrslam

@@ -41,6 +41,10 @@ struct KltOptions {
   double ssim_tracking = 0.75;
   double ssim_initialisation = 0.6;
   double ssim_reassociation = 0.9;  // a re-found point has no track history: be strict
+  // The SSIM above also scores the fitted trend plane, which the correction matches by
+  // construction; this gate scores the texture alone: the correlation of reference and window
+  // with their mean and linear trend removed, in [-1, 1] (-1: off). Pure noise scores ~0.
+  double min_texture_correlation = -1;
   void Check() const;
 };
 
@@ -60,7 +64,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureOptions, min_eigenvalue, 
                                                 max_features)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(KltOptions, window_px, levels, max_iterations, epsilon_px,
                                                 min_eigenvalue, max_displacement_px, affine_refinement, affine_iterations, ssim_tracking,
-                                                ssim_initialisation, ssim_reassociation)
+                                                ssim_initialisation, ssim_reassociation, min_texture_correlation)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FrontendOptions, masks, features, klt)
 
 }  // namespace nrslam

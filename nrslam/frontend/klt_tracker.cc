@@ -155,6 +155,19 @@ KltTracker::Trend KltTracker::TrendFromSums(const WindowSums& sums) const {
   return trend;
 }
 
+double KltTracker::TextureCorrelation(const float* a, const Trend& a_trend, const float* b, const Trend& b_trend) const {
+  double ab = 0, aa = 0, bb = 0;
+  for (int i = 0; i < area_; ++i) {
+    const double u = i % window_ - half_, v = i / window_ - half_;
+    const double da = a[i] - a_trend.mean - a_trend.slope_u * u - a_trend.slope_v * v;
+    const double db = b[i] - b_trend.mean - b_trend.slope_u * u - b_trend.slope_v * v;
+    ab += da * db;
+    aa += da * da;
+    bb += db * db;
+  }
+  return aa > 1e-12 && bb > 1e-12 ? ab / std::sqrt(aa * bb) : 0.0;
+}
+
 KltTracker::Trend KltTracker::WindowTrend(const float* window) const {
   WindowSums sums;
   for (int r = 0; r < window_; ++r) {
@@ -201,10 +214,6 @@ void KltTracker::AccumulateTranslated(const cv::Mat& image, float x, float y, co
     sums->gx_j += gx_j;
     sums->gy_j += gy_j;
   }
-}
-
-KltTracker::Photometric KltTracker::FitPhotometric(size_t slot, const float* window) const {
-  return FitTrend(slot, WindowTrend(window));
 }
 
 KltTracker::Photometric KltTracker::FitFromSums(size_t slot, const WindowSums& sums) const {
@@ -456,12 +465,17 @@ KltResult KltTracker::TrackFrom(const ImagePyramid& current, size_t index, const
   result.position = cv::Point2f(x, y);
   // SSIM of the reference against the tracked patch with its gain and bias undone.
   SampleAffine(base, x, y, linear, warped);
-  const Photometric fit = FitPhotometric(slot, warped);
+  const Trend window_trend = WindowTrend(warped);
+  const Photometric fit = FitTrend(slot, window_trend);
+  const bool texture_matches =
+      options_.min_texture_correlation <= -1 ||
+      TextureCorrelation(patch, reference_trend_[slot], warped, window_trend) >= options_.min_texture_correlation;
   Correct(fit, warped);
   result.gain = fit.gain;
   result.bias = fit.bias;
   result.ssim = Ssim(patch, warped, area_);
-  result.status = fit.textured && result.ssim >= ssim_threshold ? KltStatus::kTracked : KltStatus::kSsimRejected;
+  result.status =
+      fit.textured && texture_matches && result.ssim >= ssim_threshold ? KltStatus::kTracked : KltStatus::kSsimRejected;
   return result;
 }
 

@@ -87,6 +87,8 @@ class KltTracker {
   // The appearance the photometric fit absorbs is spanned by 1, u, v and the patch; these
   // remove it from a steepest-descent image (project-out).
   void DetrendedUnitPatch(const float* patch, const Trend& trend, float* out) const;
+  // Correlation of two windows with their mean and linear trend removed (the texture), in [-1, 1].
+  double TextureCorrelation(const float* a, const Trend& a_trend, const float* b, const Trend& b_trend) const;
   void ProjectOutAppearance(const float* unit_patch, float* image) const;
   // Running sums over a window J: Σ J, Σ J², Σ J·u, Σ J·v, and Σ ∇T·J for the step.
   struct WindowSums {
@@ -98,7 +100,6 @@ class KltTracker {
                             WindowSums* sums) const;
   Photometric FitTrend(size_t slot, const Trend& current) const;
   Photometric FitFromSums(size_t slot, const WindowSums& sums) const;
-  Photometric FitPhotometric(size_t slot, const float* window) const;  // gain and bias plane
   Photometric FitGainBias(size_t slot, const float* window) const;    // gain and constant bias
   void Correct(const Photometric& fit, float* window) const;
   void SampleAffine(const cv::Mat& image, float x, float y, const float* linear, float* out) const;
