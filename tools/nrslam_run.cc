@@ -47,8 +47,8 @@ int main(int argc, char** argv) {
     }
     if (summary.trajectory_error.evaluated) std::cout << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
     std::cout << summary.fps << " fps\n";
-    if (summary.Status() == "not_initialised") std::cout << "never initialised: " << summary.stop_reason << '\n';
-    if (summary.Status() == "lost") std::cout << "lost from frame " << summary.stop_frame << ": " << summary.stop_reason << '\n';
+    const std::string stop = nrslam::DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
+    if (!stop.empty()) std::cout << stop << '\n';
     std::cout << "run folder: " << out << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_run: " << e.what() << '\n';

@@ -133,7 +133,6 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   return html.str();
 }
 
-// With sweeps: mean RMSE against each swept option's value, one line per sequence.
 // A table of text cells, each escaped.
 std::string HtmlTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows) {
   std::ostringstream html;
@@ -149,6 +148,7 @@ std::string HtmlTable(const std::vector<std::string>& header, const std::vector<
   return html.str();
 }
 
+// With sweeps: mean RMSE against each swept option's value, one line per sequence.
 std::string SweepSection(const std::vector<RunResult>& results) {
   // option → sequence → value → (sum, n): each point averages over the other options' values.
   std::map<std::string, std::map<std::string, std::map<double, std::pair<double, int>>>> curves;

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "nrslam/system/run_sequence.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
@@ -99,9 +100,7 @@ std::string RmseChangeCounts::ToString() const {
 }
 
 std::string StopText(const RunResult& result) {
-  if (result.status == "failed" || result.stop_reason.empty()) return "";
-  if (result.init_frame < 0) return "never initialised: " + result.stop_reason;
-  return "lost from frame " + std::to_string(result.stop_frame) + ": " + result.stop_reason;
+  return result.status == "failed" ? "" : DescribeStop(result.init_frame, result.stop_frame, result.stop_reason);
 }
 
 std::string RmseCell(const RunResult& result, double rmse_mm) {

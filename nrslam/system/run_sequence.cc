@@ -120,6 +120,12 @@ class FrameIo {
 
 }  // namespace
 
+std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason) {
+  if (reason.empty()) return "";
+  if (init_frame < 0) return "never initialised: " + reason;
+  return "lost from frame " + std::to_string(stop_frame) + ": " + reason;
+}
+
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
   return stop_frame >= 0 ? "lost" : "ok";

@@ -43,6 +43,10 @@ struct RunSummary {
   std::string Status() const;
 };
 
+// How a run that ends without tracking stopped: "lost from frame 12: only 7 points left after
+// outlier rejection" or "never initialised: …"; "" when `reason` is empty (it ends tracking).
+std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason);
+
 using RunProgress = std::function<void(int frame, int total, const std::string& line)>;
 
 // Throws Error for a bad sequence or options (before anything is written); a lost track is a

@@ -483,9 +483,11 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
   std::vector<bool> demoted(observations.size(), false);
   if (!options_.rigid) {
-    std::vector<Eigen::Vector3d> before;  // to measure this frame's motion of every point, seeds for the next
+    // This frame's seeds are taken: the buffer now holds where every point starts, and below
+    // becomes how far tracking moved it (the next frame's seeds), without a new allocation.
     if (options_.deformation_motion_seed) {
-      for (const MapPoint& point : map_->points()) before.push_back(point.position);
+      point_motion_.resize(map_->size());
+      for (size_t id = 0; id < point_motion_.size(); ++id) point_motion_[id] = map_->points()[id].position;
     }
     const JointSolveTimes times = SolveDeformation(observations, motion_seeds, &pose, &displacements, &inliers);
     result.ms_joint_solve = times.ms_total;
@@ -516,8 +518,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     }
     map_->graph().UpdatePoints(updated_ids, map_->Positions());
     result.propagated = PropagateMotion(optimised, demoted_ids);
-    point_motion_.resize(before.size());
-    for (size_t id = 0; id < before.size(); ++id) point_motion_[id] = map_->points()[id].position - before[id];
+    for (size_t id = 0; id < point_motion_.size(); ++id) point_motion_[id] = map_->points()[id].position - point_motion_[id];
   }
   result.ms_deformation = MillisecondsSince(deformation_start);
 

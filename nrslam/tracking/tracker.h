@@ -135,7 +135,8 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialised;
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
-  // By point id: how far the last frame's tracking moved it (with deformation_motion_seed).
+  // By point id: how far the last frame's tracking moved it (with deformation_motion_seed;
+  // during the deformation stage, where each point started).
   std::vector<Eigen::Vector3d> point_motion_;
   int frames_since_keyframe_ = 0;
   bool candidates_ = false;
