@@ -122,8 +122,8 @@ TEST(DeformationGraph, PrunesEdgesBetweenSeparatingClusters) {
     graph.UpdatePoints(positions.Ids(), positions.Lookup());
   }
   size_t across_pruned = 0, within_pruned = 0;
-  for (size_t e = 0; e < graph.edge_count(); ++e) {
-    const GraphEdge& edge = graph.edge(static_cast<int>(e));
+  for (const int e : graph.EdgeIndices()) {
+    const GraphEdge& edge = graph.edge(e);
     const bool across = (edge.a < 100) != (edge.b < 100);
     (across ? across_pruned : within_pruned) += edge.pruned ? 1 : 0;
   }
@@ -213,8 +213,8 @@ TEST(DeformationGraph, CountsAndBestEdgesAgreeWithTheEdgeRecordsAfterUpdates) {
   for (const PointId id : positions.Ids()) {
     int unpruned = 0;
     std::vector<std::pair<double, PointId>> usable;
-    for (size_t e = 0; e < graph.edge_count(); ++e) {
-      const GraphEdge& edge = graph.edge(static_cast<int>(e));
+    for (const int e : graph.EdgeIndices()) {
+      const GraphEdge& edge = graph.edge(e);
       if (edge.a != id && edge.b != id) continue;
       if (!edge.pruned) ++unpruned;
       if (!edge.pruned && edge.weight >= options.min_edge_weight) usable.emplace_back(-edge.weight, edge.a == id ? edge.b : edge.a);
@@ -229,6 +229,105 @@ TEST(DeformationGraph, CountsAndBestEdgesAgreeWithTheEdgeRecordsAfterUpdates) {
       EXPECT_EQ(best[i].weight, -usable[i].first);
     }
   }
+}
+
+TEST(DeformationGraph, RetiringErasesOnlyTheEdgesBetweenRetiredPoints) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 5.0);
+  Positions positions;
+  for (PointId id = 0; id < 6; ++id) positions.at[id] = {0.5 * id, 0.1 * id * id, 0};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  ASSERT_EQ(graph.edge_count(), 15u);
+  graph.Retire({0, 1, 2}, 6);
+  EXPECT_TRUE(graph.IsRetired(3));
+  EXPECT_FALSE(graph.IsRetired(2));
+  EXPECT_EQ(graph.edge_count(), 12u);  // 3–4, 3–5, 4–5 erased
+  EXPECT_FALSE(graph.FindEdge(3, 4));
+  EXPECT_TRUE(graph.FindEdge(0, 3));
+  EXPECT_EQ(graph.GoodEdgeCount(0), 5);  // its edges to retired points still count
+  // A retired point's edges to live ones are still measured from the live end, and pruned.
+  positions.at[0] = {-20, 0, 0};
+  graph.UpdatePoints({0}, positions.Lookup());
+  EXPECT_TRUE(graph.edge(*graph.FindEdge(0, 4)).pruned);
+  EXPECT_EQ(graph.GoodEdgeCount(0), 0);
+  // Handing a retired point back is a logic error, never silently a different graph.
+  EXPECT_THROW(graph.GoodEdgeCount(3), Error);
+  EXPECT_THROW(graph.UpdatePoints({1, 3}, positions.Lookup()), Error);
+  EXPECT_THROW(graph.PairsAmong({0, 4}), Error);
+  EXPECT_THROW(graph.BestNeighbours(5), Error);
+  EXPECT_THROW(graph.ResetRestShape({5}, positions.Lookup()), Error);
+  positions.at[6] = {1, 1, 1};
+  EXPECT_THROW(graph.ConnectCovisible({6}, {3}, positions.Lookup()), Error);
+  // Retired stays retired; new edges fill the erased ones' slots.
+  graph.Retire({0, 1, 3}, 6);
+  EXPECT_TRUE(graph.IsRetired(3));
+  EXPECT_EQ(graph.edge_count(), 9u);  // and 2–3, 2–4, 2–5
+  const std::vector<int> before = graph.EdgeIndices();
+  graph.ConnectCovisible({6}, {0, 1}, positions.Lookup());
+  EXPECT_EQ(graph.edge_count(), 11u);
+  for (const int e : graph.EdgeIndices()) EXPECT_LT(e, 15);
+  EXPECT_DOUBLE_EQ(graph.edge(*graph.FindEdge(6, 1)).rest_length, (positions.at[6] - positions.at[1]).norm());
+  EXPECT_EQ(graph.GoodEdgeCount(6), 2);
+  EXPECT_EQ(before.size() + 2, graph.EdgeIndices().size());
+}
+
+// Retiring is a memory measure: two graphs fed the same run, one retiring the points the run
+// has dropped and one keeping every edge, must answer every question about the points still
+// in play the same, to the bit.
+TEST(DeformationGraph, RetiringChangesNoAnswerAboutLivePoints) {
+  DeformationModelOptions options;
+  options.max_degree_D = 4;
+  options.stretch_threshold = 0.4;
+  DeformationGraph kept(options, 1.5), retiring(options, 1.5);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(0.0, 3.0), jitter(-0.2, 0.2), chance(0.0, 1.0);
+  std::vector<Eigen::Vector3d> position;  // by id; every point keeps one, like a map
+  std::vector<PointId> live;
+  const PositionLookup lookup = [&](PointId id) -> std::optional<Eigen::Vector3d> { return position.at(id); };
+  const auto add_points = [&](int count) {
+    std::vector<PointId> created;
+    for (int n = 0; n < count; ++n) {
+      created.push_back(static_cast<PointId>(position.size()));
+      position.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+    }
+    kept.ConnectCovisible(created, live, lookup);
+    retiring.ConnectCovisible(created, live, lookup);
+    live.insert(live.end(), created.begin(), created.end());
+  };
+  add_points(30);
+  for (int step = 0; step < 40; ++step) {
+    for (const PointId id : live) position[id] += Eigen::Vector3d(jitter(random), jitter(random), jitter(random));
+    kept.UpdatePoints(live, lookup);
+    retiring.UpdatePoints(live, lookup);
+    std::vector<PointId> still;  // a tenth of the points leave for good each step, new ones join
+    for (const PointId id : live) {
+      if (chance(random) > 0.1) still.push_back(id);
+    }
+    live = still;
+    retiring.Retire(live, position.size());
+    add_points(4);
+    for (const PointId id : live) {
+      ASSERT_EQ(kept.GoodEdgeCount(id), retiring.GoodEdgeCount(id)) << "point " << id << " at step " << step;
+      const auto a = kept.BestNeighbours(id), b = retiring.BestNeighbours(id);
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t n = 0; n < a.size(); ++n) {
+        EXPECT_EQ(a[n].id, b[n].id);
+        EXPECT_EQ(a[n].weight, b[n].weight);
+      }
+    }
+    const auto pairs_kept = kept.PairsAmong(live), pairs_retiring = retiring.PairsAmong(live);
+    ASSERT_EQ(pairs_kept.size(), pairs_retiring.size());
+    for (size_t p = 0; p < pairs_kept.size(); ++p) {
+      EXPECT_EQ(pairs_kept[p].i, pairs_retiring[p].i);
+      EXPECT_EQ(pairs_kept[p].j, pairs_retiring[p].j);
+      EXPECT_EQ(kept.edge(pairs_kept[p].edge).rest_length, retiring.edge(pairs_retiring[p].edge).rest_length);
+      EXPECT_EQ(kept.edge(pairs_kept[p].edge).max_length, retiring.edge(pairs_retiring[p].edge).max_length);
+    }
+  }
+  // Most points have left by now, and with them most edges.
+  ASSERT_LT(live.size(), position.size() / 2);
+  EXPECT_LT(2 * retiring.edge_count(), kept.edge_count());
+  RecordProperty("edges", std::to_string(retiring.edge_count()) + " of " + std::to_string(kept.edge_count()));
 }
 
 }  // namespace

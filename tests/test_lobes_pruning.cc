@@ -43,8 +43,8 @@ TEST(LobesPruning, ShortEdgesAcrossTheSeamArePrunedFarMoreThanWithinALobe) {
   constexpr double kShortEdge = 10.0;  // mm
   int across = 0, across_pruned = 0, within = 0, within_pruned = 0;
   const DeformationGraph& graph = tracker.map().graph();
-  for (size_t e = 0; e < graph.edge_count(); ++e) {
-    const GraphEdge& edge = graph.edge(static_cast<int>(e));
+  for (const int e : graph.EdgeIndices()) {
+    const GraphEdge& edge = graph.edge(e);
     const int a = surface.at(edge.a), b = surface.at(edge.b);
     const bool on_lobes = (a == LobesScene::kLobeA || a == LobesScene::kLobeB) &&
                           (b == LobesScene::kLobeA || b == LobesScene::kLobeB);

@@ -19,6 +19,7 @@ void DeformationGraph::set_sigma(double sigma) {
   if (!(sigma > 0) || !std::isfinite(sigma)) throw Error("deformation graph: sigma must be > 0");
   sigma_ = sigma;
   for (size_t index = 0; index < edges_.size(); ++index) {
+    if (edges_[index].a == kNoPoint) continue;  // a free slot
     edges_[index].weight = WeightOf(edges_[index].max_length);
     UpdateRanking(static_cast<int>(index));
   }
@@ -62,28 +63,107 @@ std::optional<int> DeformationGraph::FindEdge(PointId a, PointId b) const {
   const auto node = nodes_.find(a);
   if (node == nodes_.end()) return std::nullopt;
   for (const Incidence& incidence : node->second.edges) {
-    if (incidence.other == b) return incidence.edge;
+    const GraphEdge& candidate = edges_[incidence.edge];
+    if (incidence.other == b && (candidate.a == b || candidate.b == b)) return incidence.edge;
   }
   return std::nullopt;
 }
 
 void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
+  CheckLive(a);
+  CheckLive(b);
   if (a == b || FindEdge(a, b)) return;
   if (!(length > 0) || !std::isfinite(length)) return;  // coincident or invalid points: no direction to regularise
-  const int index = static_cast<int>(edges_.size());
-  edges_.push_back({a, b, length, length, length, WeightOf(length), false});
-  ranking_weight_.push_back(0.0);
+  const GraphEdge edge{a, b, length, length, length, WeightOf(length), false};
+  int index;
+  if (free_edges_.empty()) {
+    index = static_cast<int>(edges_.size());
+    edges_.push_back(edge);
+    ranking_weight_.push_back(0.0);
+  } else {
+    index = free_edges_.back();
+    free_edges_.pop_back();
+    edges_[index] = edge;
+  }
   UpdateRanking(index);
   for (const auto& [from, to] : {std::pair(a, b), std::pair(b, a)}) {
     Node& node = nodes_[from];
     node.edges.push_back({to, index});
     ++node.unpruned;
+    ++node.present;
   }
   edge_index_.emplace(PairKey(a, b), index);
 }
 
+void DeformationGraph::EraseEdge(int index) {
+  GraphEdge& edge = edges_[index];
+  const auto key = edge_index_.find(PairKey(edge.a, edge.b));
+  if (key != edge_index_.end() && key->second == index) edge_index_.erase(key);
+  for (const PointId end : {edge.a, edge.b}) {
+    const auto node = nodes_.find(end);
+    if (!edge.pruned) --node->second.unpruned;
+    if (--node->second.present == 0) nodes_.erase(node);
+  }
+  edge = GraphEdge{};
+  edge.a = edge.b = kNoPoint;
+  edge.pruned = true;
+  ranking_weight_[index] = -1.0;
+  free_edges_.push_back(index);
+}
+
+bool DeformationGraph::IsRetired(PointId point) const {
+  return point >= 0 && static_cast<size_t>(point) < retired_.size() && retired_[static_cast<size_t>(point)];
+}
+
+void DeformationGraph::CheckLive(PointId point) const {
+  if (IsRetired(point)) {
+    throw Error("deformation graph: point " + std::to_string(point) + " was retired and cannot be used again");
+  }
+}
+
+void DeformationGraph::CheckLive(const std::vector<PointId>& points) const {
+  for (const PointId point : points) CheckLive(point);
+}
+
+void DeformationGraph::Retire(const std::vector<PointId>& live, size_t point_count) {
+  std::vector<bool> keep(point_count, false);
+  for (const PointId id : live) {
+    if (id >= 0 && static_cast<size_t>(id) < point_count) keep[static_cast<size_t>(id)] = true;
+  }
+  if (retired_.size() < point_count) retired_.resize(point_count, false);
+  std::vector<PointId> newly_retired;
+  for (size_t id = 0; id < point_count; ++id) {
+    if (keep[id] || retired_[id]) continue;
+    retired_[id] = true;
+    newly_retired.push_back(static_cast<PointId>(id));
+  }
+  for (const PointId id : newly_retired) {
+    const auto node = nodes_.find(id);
+    if (node == nodes_.end()) continue;
+    // Nothing reads a retired point's list again: it goes now, and the counts stay for the
+    // edges to live points. Its entries are all present (an edge is erased only once both
+    // ends are retired), except those erased just now from a point retired beside it.
+    const std::vector<Incidence> incidences = std::move(node->second.edges);
+    node->second.edges = {};
+    for (const Incidence& incidence : incidences) {
+      if (edges_[incidence.edge].a != kNoPoint && IsRetired(incidence.other)) EraseEdge(incidence.edge);
+    }
+  }
+}
+
+std::vector<int> DeformationGraph::EdgeIndices() const {
+  std::vector<int> indices;
+  indices.reserve(edge_count());
+  for (size_t index = 0; index < edges_.size(); ++index) {
+    if (edges_[index].a != kNoPoint) indices.push_back(static_cast<int>(index));
+  }
+  return indices;
+}
+
 void DeformationGraph::ConnectCovisible(const std::vector<PointId>& new_points, const std::vector<PointId>& existing,
                                         const PositionLookup& position) {
+  CheckLive(new_points);
+  CheckLive(existing);
   std::vector<std::pair<PointId, Eigen::Vector3d>> located;
   for (PointId id : new_points) {
     if (const auto p = position(id)) located.emplace_back(id, *p);
@@ -124,6 +204,7 @@ class ListPositions {
 }  // namespace
 
 void DeformationGraph::UpdatePoints(const std::vector<PointId>& points, const PositionLookup& position) {
+  CheckLive(points);
   const ListPositions listed(points);
   for (PointId point : points) {
     const auto node = nodes_.find(point);
@@ -139,6 +220,7 @@ void DeformationGraph::UpdatePoints(const std::vector<PointId>& points, const Po
 }
 
 void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const PositionLookup& position) {
+  CheckLive(points);
   const std::unordered_set<PointId> chosen(points.begin(), points.end());
   for (PointId point : points) {
     const auto node = nodes_.find(point);
@@ -180,6 +262,7 @@ void DeformationGraph::SelectBest(PointId point, const Eligible& eligible, std::
 
 std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
                                                              const std::function<bool(PointId)>& eligible) const {
+  CheckLive(point);
   std::vector<GraphNeighbour> best;
   if (eligible) {
     SelectBest(point, eligible, &best);
@@ -190,6 +273,7 @@ std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
 }
 
 std::vector<GraphPair> DeformationGraph::PairsAmong(const std::vector<PointId>& points) const {
+  CheckLive(points);
   const ListPositions listed(points);
   const auto is_listed = [&](PointId id) { return listed.Contains(id); };
   // Point i's chosen neighbours (list positions) are chosen[i·D, i·D + chosen_count[i]):
@@ -214,12 +298,14 @@ std::vector<GraphPair> DeformationGraph::PairsAmong(const std::vector<PointId>& 
 }
 
 int DeformationGraph::GoodEdgeCount(PointId point) const {
+  CheckLive(point);
   const auto node = nodes_.find(point);
   return node == nodes_.end() ? 0 : node->second.unpruned;
 }
 
 size_t DeformationGraph::pruned_count() const {
-  return static_cast<size_t>(std::count_if(edges_.begin(), edges_.end(), [](const GraphEdge& e) { return e.pruned; }));
+  return static_cast<size_t>(
+      std::count_if(edges_.begin(), edges_.end(), [](const GraphEdge& e) { return e.pruned && e.a != kNoPoint; }));
 }
 
 }  // namespace nrslam

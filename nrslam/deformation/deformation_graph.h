@@ -6,6 +6,10 @@
 // weight b = exp(−d_max² / 2σ²). An edge is pruned — for good, since d_max only grows and
 // d_min only shrinks — once (d_max − d_min)/d_min exceeds the stretching threshold: the two
 // points no longer deform together. Each point is regularised by its best D unpruned edges.
+//
+// Points that the system has dropped for good are retired (Retire): an edge between two
+// retired points can never be read again and is erased, so a long run holds the edges of the
+// points still in play rather than every edge it ever made.
 #pragma once
 
 #include <Eigen/Core>
@@ -82,11 +86,23 @@ class DeformationGraph {
   std::vector<GraphPair> PairsAmong(const std::vector<PointId>& points) const;
   // Unpruned edges of the point (kept as a count: asked for every point every frame).
   int GoodEdgeCount(PointId point) const;
+
+  // Retires every point with an id below `point_count` that is not in `live`; retired points
+  // stay retired. The caller promises never to hand a retired point to the functions above
+  // (they throw if it does): the tracker and mapper drop a point for good once it is neither
+  // tracked, nor lost and looked for, nor in the DBA window. An edge between two retired
+  // points is then never read again and is erased. An edge from a retired point to a live one
+  // stays: the live end still measures it, and it still counts towards the live end's
+  // unpruned edges until it is pruned. So retiring changes no result, only the memory.
+  void Retire(const std::vector<PointId>& live, size_t point_count);
+  bool IsRetired(PointId point) const;
   // Fewer than min_good_edges unpruned edges left: the point's deformation is unconstrained.
   bool IsWeaklyConnected(PointId point) const { return GoodEdgeCount(point) < options_.min_good_edges; }
 
   const GraphEdge& edge(int index) const { return edges_[index]; }
-  size_t edge_count() const { return edges_.size(); }
+  // Every edge's index (erased edges leave holes that new edges fill).
+  std::vector<int> EdgeIndices() const;
+  size_t edge_count() const { return edges_.size() - free_edges_.size(); }
   size_t pruned_count() const;
   std::optional<int> FindEdge(PointId a, PointId b) const;
 
@@ -98,10 +114,15 @@ class DeformationGraph {
     int edge;
   };
   struct Node {
+    // A retired node's list may still name edges erased since (never read again); `present`
+    // counts the ones that are not, and the node goes when it reaches 0.
     std::vector<Incidence> edges;
     int unpruned = 0;
+    int present = 0;
   };
-  std::vector<GraphEdge> edges_;
+  std::vector<GraphEdge> edges_;  // a free slot has a == kNoPoint
+  std::vector<int> free_edges_;
+  std::vector<bool> retired_;     // by point id
   // Per edge, b if it may regularise (unpruned, b >= min_edge_weight), else −1: what the
   // best-D choice reads for each of a point's edges, packed densely because a complete graph
   // gives every point hundreds of them and the choice is made for every point every frame.
@@ -114,6 +135,10 @@ class DeformationGraph {
   void SelectBest(PointId point, const Eligible& eligible, std::vector<GraphNeighbour>* best) const;
   void Remeasure(int index, double length);  // a new observed length: d_min, d_max, b, pruning
   void UpdateRanking(int index);
+  void EraseEdge(int index);
+  // Throws unless every point may still be read (none is retired).
+  void CheckLive(const std::vector<PointId>& points) const;
+  void CheckLive(PointId point) const;
   static uint64_t PairKey(PointId a, PointId b);
 };
 

@@ -81,6 +81,12 @@ MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tra
   return report;
 }
 
+std::vector<PointId> Mapper::WindowPoints() const {
+  std::vector<PointId> ids;
+  for (const Keyframe& keyframe : keyframes_) ids.insert(ids.end(), keyframe.ids.begin(), keyframe.ids.end());
+  return ids;
+}
+
 namespace {
 
 std::vector<Keyframe*> Pointers(std::deque<Keyframe>* keyframes) {

@@ -47,6 +47,8 @@ class Mapper {
   MappingReport Process(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker);
 
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
+  // The points the DBA window observes (a DBA in flight adjusts the same window).
+  std::vector<PointId> WindowPoints() const;
 
  private:
   struct Snapshot {

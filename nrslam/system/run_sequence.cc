@@ -209,6 +209,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
             log << line.str();
           }
         }
+        // Once per keyframe: what neither tracking nor the DBA window holds is gone for good.
+        if (result.keyframe) tracker.RetireDroppedPoints(mapper.WindowPoints());
       } else if (tracker.state() == TrackingState::kLost && !monocular && !options.run.reinitialise_after_loss) {
         result.state = TrackingState::kLost;
         result.note = "lost earlier; not re-initialised (run.reinitialise_after_loss=false)";

@@ -193,6 +193,15 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
   frames_since_keyframe_ = 0;
 }
 
+void Tracker::RetireDroppedPoints(std::vector<PointId> in_use_elsewhere) {
+  std::vector<PointId>& in_use = in_use_elsewhere;
+  for (const PointTrack& track : tracks_) {
+    if (track.active && track.id != kNoPoint) in_use.push_back(track.id);
+  }
+  for (const auto& entry : lost_) in_use.push_back(entry.first);
+  map_->graph().Retire(in_use, map_->size());
+}
+
 void Tracker::LoseTrack(PointTrack* track, int frame) {
   track->active = false;
   if (!track->patch.keyframe || track->id == kNoPoint) return;
