@@ -24,6 +24,7 @@
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
 #include "nrslam/sim/simulate.h"
+#include "nrslam/system/external_result.h"
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
@@ -156,6 +157,109 @@ TEST_F(RunSequenceTest, TrajectoryErrorIsRecomputableFromTheTumFilesAndSmall) {
   EXPECT_LT(recomputed.rmse_mm, 0.05 * travel);
   // Initialised from depth in mm: the map is already in mm.
   EXPECT_NEAR(recomputed.scale, 1.0, 0.1);
+}
+
+// Another system's output is scored as a run of ours: given this run's own points and
+// trajectory as if they came from elsewhere, the scorer must reach the run's own figures, and
+// its run folder must be one that the other tools read (here, the common-point comparison).
+TEST_F(RunSequenceTest, ScoringTheRunsOwnOutputAsAnExternalResultGivesItsSummary) {
+  ExternalResult external;
+  external.estimates = *base_ / "run" / "points.csv";
+  external.trajectory = *base_ / "run" / "trajectory.tum";
+  external.name = "the run itself";
+  const fs::path scored = *base_ / "scored";
+  const RunSummary summary = ScoreExternalResult(*base_ / "sequence", external, EvaluationOptions{}, scored);
+  EXPECT_EQ(summary.frames_tracked, summary_->frames_tracked);
+  EXPECT_EQ(summary.init_frame, 0);
+  EXPECT_EQ(summary.Status(), "ok");
+  EXPECT_EQ(summary.frames_evaluated, summary_->frames_evaluated);
+  EXPECT_NEAR(summary.rmse_mm, summary_->rmse_mm, 1e-5);
+  EXPECT_NEAR(summary.rmse_flat_mm, summary_->rmse_flat_mm, 1e-5);
+  ASSERT_TRUE(summary.trajectory_error.evaluated);
+  EXPECT_NEAR(summary.trajectory_error.rmse_mm, summary_->trajectory_error.rmse_mm, 1e-4);
+  for (const char* file : {"config.json", "points.csv", "metrics.csv", "summary.json", "trajectory.tum"}) {
+    EXPECT_TRUE(fs::exists(scored / file)) << file;
+  }
+  EXPECT_TRUE(fs::exists(scored / "depth" / "000039.png"));
+  nlohmann::json written;
+  std::ifstream(scored / "summary.json") >> written;
+  EXPECT_EQ(written.at("mode"), "external");
+  EXPECT_NEAR(written.at("rmse_mm").get<double>(), summary_->rmse_mm, 1e-5);
+  // The world positions it derives from pixel, depth and pose are the run's own, up to the
+  // reprojection residual of a kept point (under 2.45 px: ~0.7 mm at these depths); a pose
+  // taken the wrong way round would put them many millimetres off.
+  const std::vector<CsvPoint> own = ReadPointsCsv(*base_ / "run" / "points.csv");
+  const std::vector<CsvPoint> derived = ReadPointsCsv(scored / "points.csv");
+  ASSERT_EQ(own.size(), derived.size());
+  std::vector<double> offsets;
+  for (size_t i = 0; i < own.size(); ++i) offsets.push_back((own[i].world - derived[i].world).norm());
+  std::sort(offsets.begin(), offsets.end());
+  EXPECT_LT(offsets[offsets.size() / 2], 0.1);
+  EXPECT_LT(offsets.back(), 1.0);
+  const CommonPointsComparison comparison = CompareRunFolders(*base_ / "run", scored);
+  EXPECT_EQ(comparison.frames, summary_->frames_evaluated);
+  EXPECT_NEAR(comparison.b_common.rmse_mm, summary_->rmse_mm, 1e-5);
+}
+
+// Known answers: depth images that are the ground truth at half scale, for frames 0–9 but 5,
+// score an RMSE of 0 at a scale of 2, and the frames without an image count as lost.
+TEST_F(RunSequenceTest, ExternalDepthImagesScoreAsKnown) {
+  const SequenceReader reader(*base_ / "sequence");
+  const fs::path images = *base_ / "half_depth";
+  fs::create_directories(images);
+  for (int frame = 0; frame < 10; ++frame) {
+    if (frame == 5) continue;
+    cv::Mat half;
+    reader.ReadDepthMm(frame).convertTo(half, CV_32F, 0.5);
+    ASSERT_TRUE(cv::imwrite((images / ("estimate_" + std::to_string(frame) + ".tiff")).string(), half));
+  }
+  ExternalResult external;
+  external.estimates = images;
+  external.depth_stride_px = 4;
+  const fs::path scored = *base_ / "scored_images";
+  const RunSummary summary = ScoreExternalResult(*base_ / "sequence", external, EvaluationOptions{}, scored);
+  EXPECT_EQ(summary.init_frame, 0);
+  EXPECT_EQ(summary.frames_tracked, 9);
+  EXPECT_EQ(summary.frames_lost, 31);
+  EXPECT_EQ(summary.Status(), "lost");
+  EXPECT_EQ(summary.stop_frame, 10);
+  EXPECT_EQ(summary.frames_evaluated, 9);
+  EXPECT_LT(summary.rmse_mm, 1e-6);
+  EXPECT_GT(summary.rmse_flat_mm, 1.0);  // a shape was there to be recovered
+  EXPECT_FALSE(summary.trajectory_error.evaluated);
+  const std::vector<std::map<std::string, std::string>> metrics = ReadCsv(scored / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 40u);
+  EXPECT_NEAR(Number(metrics[3], "scale"), 2.0, 1e-9);
+  EXPECT_EQ(metrics[5].at("state"), "lost");
+  EXPECT_GT(Number(metrics[3], "points"), 1000);  // 80×60 samples, those on the surface
+}
+
+TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
+  const auto error_of = [&](const std::string& csv) {
+    const fs::path file = *base_ / "bad.csv";
+    std::ofstream(file) << csv;
+    ExternalResult external;
+    external.estimates = file;
+    try {
+      ScoreExternalResult(*base_ / "sequence", external, EvaluationOptions{}, *base_ / "scored_bad");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("frame,u,v\n0,1,2\n").find("no column 'z'"), std::string::npos);
+  EXPECT_NE(error_of("frame,u,v,z\n0,1,2,3\n0,1,x,3\n").find("bad.csv:3: 'x' (v) is not a number"), std::string::npos);
+  EXPECT_NE(error_of("frame,u,v,z\n40,1,2,3\n").find("frame 40 is not a frame of the sequence"), std::string::npos);
+  EXPECT_NE(error_of("frame,u,v,z\n0,1,2\n").find("3 fields, the header needs 4"), std::string::npos);
+  // An estimate a system failed to make (NaN, 0) is no estimate, not a broken file.
+  EXPECT_EQ(error_of("frame,u,v,z\n0,10,20,nan\n1,10,20,0\n"), "no error");
+  ExternalResult images;
+  images.estimates = *base_ / "wrong_size";
+  fs::create_directories(images.estimates);
+  cv::imwrite((images.estimates / "000000.png").string(), cv::Mat(10, 10, CV_16UC1, cv::Scalar(100)));
+  EXPECT_THROW(ScoreExternalResult(*base_ / "sequence", images, EvaluationOptions{}, *base_ / "scored_bad"), Error);
+  images.estimates = *base_ / "missing";
+  EXPECT_THROW(ScoreExternalResult(*base_ / "sequence", images, EvaluationOptions{}, *base_ / "scored_bad"), Error);
 }
 
 // A run folder's config.json repeats the run: the same options, and the same trajectory.

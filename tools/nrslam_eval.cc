@@ -4,7 +4,8 @@
 // writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
 // result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere); `nrslam_eval
 // compare RUN_A RUN_B` scores two runs of one sequence on the points both report; `nrslam_eval
-// diff EVAL_A EVAL_B` sets two evaluations of the same runs side by side, run for run.
+// diff EVAL_A EVAL_B` sets two evaluations of the same runs side by side, run for run;
+// `nrslam_eval score SEQUENCE ESTIMATES --out DIR` scores another system's output as a run.
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "nrslam/batch/results_diff.h"
 #include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/batch/run_folder.h"
+#include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/text_table.h"
@@ -120,10 +122,29 @@ int main(int argc, char** argv) {
                                               "code) side by side, run for run");
   std::vector<std::string> diffed;
   diff->add_option("evaluations", diffed, "two result folders (each with results.json)")->required()->expected(2);
+  CLI::App* score = app.add_subcommand("score", "score another system's output on a sequence as a run of ours is "
+                                                "scored, into a run folder (--out)");
+  score->fallthrough();  // --out given after "score"
+  std::string scored_sequence;
+  nrslam::ExternalResult external;
+  score->add_option("sequence", scored_sequence, "the sequence folder (with depth/ for the RMSE)")->required();
+  score->add_option("estimates", external.estimates, "a CSV file (frame,u,v,z[,point_id]) or a folder of depth images")
+      ->required();
+  score->add_option("--trajectory", external.trajectory, "its camera trajectory (TUM, world_from_camera, t = frame / fps)");
+  score->add_option("--stride", external.depth_stride_px, "depth images: one point every this many pixels")
+      ->capture_default_str();
+  score->add_option("--name", external.name, "what produced it, recorded in config.json (e.g. DefSLAM)");
   CLI11_PARSE(app, argc, argv);
 
   try {
     if (compare->parsed()) return Compare(compared[0], compared[1]);
+    if (score->parsed()) {
+      if (app.count("--out") == 0) throw nrslam::Error("score writes a run folder: give it with --out");
+      const nrslam::RunSummary summary =
+          nrslam::ScoreExternalResult(scored_sequence, external, nrslam::EvaluationOptions{}, out);
+      std::cout << nrslam::DescribeSummary(summary) << "\nrun folder: " << out << '\n';
+      return 0;
+    }
     if (diff->parsed()) {
       const nrslam::ResultsDiff result = nrslam::DiffResults(nrslam::ReadResults(diffed[0]), nrslam::ReadResults(diffed[1]));
       nrslam::PrintDiff(result, diffed[0], diffed[1], std::cout);

@@ -37,18 +37,7 @@ int main(int argc, char** argv) {
       if (!quiet) std::cerr << '\r' << line << "      " << std::flush;
       if (!quiet && done == total) std::cerr << '\n';
     });
-    std::cout << "frames tracked " << summary.frames_tracked << "/" << summary.frames_total << " (init at "
-              << summary.init_frame << ", lost " << summary.frames_lost << ")  ";
-    if (summary.frames_evaluated > 0) {
-      std::cout << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
-                << summary.rmse_flat_mm << " mm)  ";
-    } else {
-      std::cout << "no ground truth, no RMSE  ";
-    }
-    if (summary.trajectory_error.evaluated) std::cout << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
-    std::cout << summary.fps << " fps\n";
-    const std::string stop = nrslam::DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
-    if (!stop.empty()) std::cout << stop << '\n';
+    std::cout << nrslam::DescribeSummary(summary) << '\n';
     std::cout << "run folder: " << out << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_run: " << e.what() << '\n';

@@ -34,13 +34,6 @@ Camera CameraOverride(const fs::path& file, const SequenceReader& reader) {
   return camera;
 }
 
-std::ofstream OpenForWriting(const fs::path& path) {
-  std::ofstream file(path);
-  if (!file) throw Error("cannot write " + path.string());
-  file << std::setprecision(9);
-  return file;
-}
-
 void WritePly(const fs::path& path, const Map& map) {
   std::ofstream file = OpenForWriting(path);
   file << "ply\nformat ascii 1.0\nelement vertex " << map.size()
@@ -50,22 +43,6 @@ void WritePly(const fs::path& path, const Map& map) {
     file << point.position.x() << ' ' << point.position.y() << ' ' << point.position.z() << ' '
          << int(point.colour[2]) << ' ' << int(point.colour[1]) << ' ' << int(point.colour[0]) << '\n';
   }
-}
-
-// Estimated depth image: each point a 3x3 splat, mm via the frame's scale when known.
-cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, const cv::Size& size, double unit_mm) {
-  cv::Mat depth = cv::Mat::zeros(size, CV_16UC1);
-  for (const auto& [pixel, depth_mm] : points) {
-    const double value = std::round(depth_mm / unit_mm);
-    if (!(value > 0) || value > 65535) continue;
-    const int cx = cvRound(pixel.x), cy = cvRound(pixel.y);
-    for (int y = std::max(0, cy - 1); y <= std::min(size.height - 1, cy + 1); ++y) {
-      for (int x = std::max(0, cx - 1); x <= std::min(size.width - 1, cx + 1); ++x) {
-        depth.at<uint16_t>(y, x) = static_cast<uint16_t>(value);
-      }
-    }
-  }
-  return depth;
 }
 
 struct FrameImages {
@@ -120,17 +97,6 @@ class FrameIo {
 
 }  // namespace
 
-std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason) {
-  if (reason.empty()) return "";
-  if (init_frame < 0) return "never initialised: " + reason;
-  return "lost from frame " + std::to_string(stop_frame) + ": " + reason;
-}
-
-std::string RunSummary::Status() const {
-  if (init_frame < 0) return "not_initialised";
-  return stop_frame >= 0 ? "lost" : "ok";
-}
-
 RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, const fs::path& out,
                        const RunProgress& progress) {
   options.Check();
@@ -143,25 +109,10 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   const int last = options.run.last_frame < 0 ? reader.frame_count() : std::min(options.run.last_frame, reader.frame_count());
   if (first >= last) throw Error("the frame range selects no frame of " + sequence.string());
 
-  std::error_code error;
-  fs::create_directories(out / "depth", error);
-  if (error) throw Error("cannot create " + out.string() + ": " + error.message());
-  {
-    std::ofstream config = OpenForWriting(out / "config.json");
-    config << nlohmann::json{{"nrslam_version", NRSLAM_VERSION},
-                             {"sequence", fs::absolute(sequence).string()},
-                             {"sequence_info", reader.info()},
-                             {"camera", camera},
-                             {"options", options}}
-                  .dump(2)
-           << '\n';
-  }
-  std::ofstream points_csv = OpenForWriting(out / "points.csv");
-  points_csv << "frame,point_id,u,v,z_est,x,y,z,status\n";
-  std::ofstream metrics_csv = OpenForWriting(out / "metrics.csv");
-  metrics_csv << "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,deformable_candidates,new_points,"
-                 "points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,ms_dba,ms_triangulation,ms_total,"
-                 "ms_joint_solve,ms_linear_solve,note\n";
+  RunFolderStreams streams =
+      BeginRunFolder(out, sequence, {{"sequence_info", reader.info()}, {"camera", camera}, {"options", options}});
+  std::ofstream& points_csv = streams.points;
+  std::ofstream& metrics_csv = streams.metrics;
   std::ofstream log = OpenForWriting(out / "run.log");
 
   Tracker tracker(camera, options.frontend, options.deformation, options.tracking);
@@ -314,47 +265,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.ms_triangulation = ms_triangulation / summary.frames_total;
   summary.maps = maps;
   summary.map_points = tracker.map().size();
-  const SequenceMetrics metrics = AggregateFrames(evaluations);
-  summary.rmse_mm = metrics.rmse_mm;
-  summary.rmse_median_mm = metrics.rmse_median_mm;
-  summary.rmse_pooled_mm = metrics.rmse_pooled_mm;
-  summary.rmse_flat_mm = metrics.rmse_flat_mm;
-  summary.frames_evaluated = metrics.frames_evaluated;
-  summary.trajectory_error = AlignedTrajectoryError(aligned_maps);
-  const TrajectoryError& trajectory_error = summary.trajectory_error;
+  AggregateInto(&summary, evaluations, aligned_maps);
 
   WriteTum(out / "trajectory.tum", trajectory);
   WritePly(out / "map.ply", tracker.map());
-  std::ofstream summary_json = OpenForWriting(out / "summary.json");
-  summary_json << nlohmann::json{{"rmse_mm", summary.rmse_mm},
-                                 {"rmse_median_mm", summary.rmse_median_mm},
-                                 {"rmse_pooled_mm", summary.rmse_pooled_mm},
-                                 {"rmse_flat_mm", summary.rmse_flat_mm},
-                                 {"frames_tracked", summary.frames_tracked},
-                                 {"frames_total", summary.frames_total},
-                                 {"frames_lost", summary.frames_lost},
-                                 {"frames_evaluated", summary.frames_evaluated},
-                                 {"init_frame", summary.init_frame},
-                                 {"fps", summary.fps},
-                                 {"ms_per_frame", {{"initialisation", summary.ms_initialisation},
-                                                   {"tracking", summary.ms_tracking},
-                                                   {"tracking_linear_solve", summary.ms_tracking_linear_solve},
-                                                   {"dba", summary.ms_dba},
-                                                   {"triangulation", summary.ms_triangulation}}},
-                                 {"maps", summary.maps},
-                                 // null without ground-truth poses or a moving camera
-                                 {"ate_rmse_mm", trajectory_error.evaluated ? nlohmann::json(trajectory_error.rmse_mm) : nlohmann::json()},
-                                 {"ate_scale", trajectory_error.evaluated ? nlohmann::json(trajectory_error.scale) : nlohmann::json()},
-                                 {"ate_frames", trajectory_error.poses},
-                                 {"map_points", summary.map_points},
-                                 {"init", options.run.init},
-                                 {"mapping", options.run.mapping},
-                                 {"mode", options.tracking.rigid ? "rigid" : "deformable"},
-                                 {"status", summary.Status()},
-                                 {"stop_frame", summary.stop_frame >= 0 ? nlohmann::json(summary.stop_frame) : nlohmann::json()},
-                                 {"stop_reason", summary.stop_frame >= 0 ? nlohmann::json(summary.stop_reason) : nlohmann::json()}}
-                      .dump(2)
-               << '\n';
+  WriteSummaryJson(out / "summary.json", summary,
+                   {{"init", options.run.init},
+                    {"mapping", options.run.mapping},
+                    {"mode", options.tracking.rigid ? "rigid" : "deformable"}});
   return summary;
 }
 

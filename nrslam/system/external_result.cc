@@ -1,0 +1,265 @@
+#include "nrslam/system/external_result.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include "nrslam/io/sequence_info.h"
+#include "nrslam/io/sequence_reader.h"
+#include "nrslam/io/tum.h"
+#include "nrslam/tracking/tracker.h"
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+namespace fs = std::filesystem;
+namespace {
+
+struct EstimatedPoint {
+  int64_t id;
+  cv::Point2d pixel;
+  double depth;
+};
+using FrameEstimates = std::map<int, std::vector<EstimatedPoint>>;
+
+std::vector<std::string> SplitCsvLine(std::string line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::vector<std::string> fields;
+  std::stringstream stream(line);
+  std::string field;
+  while (std::getline(stream, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+// The whole field as a number, or nullopt ("nan" and "inf" parse: they are estimates a system
+// failed to make, not a malformed file).
+std::optional<double> ParseNumber(const std::string& field) {
+  const char* begin = field.c_str();
+  char* end = nullptr;
+  const double value = std::strtod(begin, &end);
+  if (end == begin) return std::nullopt;
+  while (*end != '\0' && std::isspace(static_cast<unsigned char>(*end))) ++end;
+  if (*end != '\0') return std::nullopt;
+  return value;
+}
+
+void CheckFrame(double frame, int frame_count, const std::string& where) {
+  if (!(frame >= 0 && frame < frame_count && frame == std::floor(frame))) {
+    std::ostringstream message;
+    message << where << ": frame " << frame << " is not a frame of the sequence (0 … " << frame_count - 1 << ")";
+    throw Error(message.str());
+  }
+}
+
+FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count) {
+  std::ifstream in(file);
+  if (!in) throw Error("cannot read " + file.string());
+  std::string line;
+  if (!std::getline(in, line)) throw Error(file.string() + " is empty: a header line is expected");
+  std::map<std::string, size_t> column;
+  const std::vector<std::string> header = SplitCsvLine(line);
+  for (size_t i = 0; i < header.size(); ++i) column.emplace(header[i], i);
+  const auto require = [&](const std::string& name) {
+    if (!column.count(name)) throw Error(file.string() + ": no column '" + name + "' in its header (frame, u, v and z are needed)");
+    return column.at(name);
+  };
+  // A run's own points.csv has both: z_est is the camera depth, z the world coordinate.
+  const size_t frame_column = require("frame"), u_column = require("u"), v_column = require("v"),
+               z_column = column.count("z_est") ? column.at("z_est") : require("z");
+  const bool has_ids = column.count("point_id") > 0;
+  const size_t id_column = has_ids ? column.at("point_id") : 0;
+  const size_t needed = std::max({frame_column, u_column, v_column, z_column, id_column}) + 1;
+  FrameEstimates estimates;
+  for (int row = 2; std::getline(in, line); ++row) {
+    if (line.empty() || line == "\r") continue;
+    const std::string where = file.string() + ":" + std::to_string(row);
+    const std::vector<std::string> fields = SplitCsvLine(line);
+    if (fields.size() < needed) {
+      throw Error(where + ": " + std::to_string(fields.size()) + " fields, the header needs " + std::to_string(needed));
+    }
+    const auto number = [&](size_t index) {
+      const std::optional<double> value = ParseNumber(fields[index]);
+      if (!value) throw Error(where + ": '" + fields[index] + "' (" + header[index] + ") is not a number");
+      return *value;
+    };
+    const double frame = number(frame_column);
+    CheckFrame(frame, frame_count, where);
+    std::vector<EstimatedPoint>& points = estimates[static_cast<int>(frame)];
+    const double u = number(u_column), v = number(v_column), z = number(z_column);
+    const auto id = has_ids ? static_cast<int64_t>(number(id_column)) : static_cast<int64_t>(points.size());
+    if (std::isfinite(u) && std::isfinite(v) && std::isfinite(z) && z > 0) points.push_back({id, {u, v}, z});
+  }
+  return estimates;
+}
+
+// The last number in a file name ("depth_000123" → 123), if any.
+std::optional<int> FrameNumberOf(const std::string& stem) {
+  size_t end = stem.size();
+  while (end > 0 && !std::isdigit(static_cast<unsigned char>(stem[end - 1]))) --end;
+  size_t begin = end;
+  while (begin > 0 && std::isdigit(static_cast<unsigned char>(stem[begin - 1]))) --begin;
+  if (begin == end || end - begin > 9) return std::nullopt;
+  return std::stoi(stem.substr(begin, end - begin));
+}
+
+FrameEstimates ReadDepthImages(const fs::path& folder, const cv::Size& size, int stride, int frame_count) {
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+    if (entry.is_regular_file() && entry.path().filename().string().front() != '.') files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  FrameEstimates estimates;
+  for (const fs::path& file : files) {
+    const std::optional<int> frame = FrameNumberOf(file.stem().string());
+    if (!frame) throw Error(file.string() + ": no frame number in the file name");
+    CheckFrame(*frame, frame_count, file.string());
+    if (estimates.count(*frame)) throw Error(file.string() + ": a second depth image of frame " + std::to_string(*frame));
+    const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+    if (image.empty()) throw Error("cannot read " + file.string() + " as an image");
+    if (image.channels() != 1) throw Error(file.string() + ": a depth image has one channel, this one " + std::to_string(image.channels()));
+    if (image.size() != size) {
+      throw Error(file.string() + " is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                  ", the sequence's images are " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    }
+    cv::Mat depth;
+    image.convertTo(depth, CV_64F);
+    std::vector<EstimatedPoint>& points = estimates[*frame];
+    for (int y = stride / 2; y < depth.rows; y += stride) {
+      for (int x = stride / 2; x < depth.cols; x += stride) {
+        const double z = depth.at<double>(y, x);
+        if (std::isfinite(z) && z > 0) points.push_back({static_cast<int64_t>(y) * depth.cols + x, {double(x), double(y)}, z});
+      }
+    }
+  }
+  return estimates;
+}
+
+std::map<int, Rigid3> ReadTrajectory(const fs::path& file, double fps, int frame_count) {
+  std::map<int, Rigid3> poses;
+  for (const StampedPose& pose : ReadTum(file)) {
+    const double frame = std::round(pose.timestamp * fps);
+    const std::string where = file.string() + " (t = " + std::to_string(pose.timestamp) + " s)";
+    CheckFrame(frame, frame_count, where);
+    if (!poses.emplace(static_cast<int>(frame), pose.world_from_camera).second) {
+      throw Error(where + ": a second pose of frame " + std::to_string(static_cast<int>(frame)));
+    }
+  }
+  return poses;
+}
+
+}  // namespace
+
+void ExternalResult::Check() const {
+  if (estimates.empty()) throw Error("external result: no estimates given (a CSV file or a folder of depth images)");
+  if (!fs::exists(estimates)) throw Error("external result: " + estimates.string() + " does not exist");
+  if (!trajectory.empty() && !fs::is_regular_file(trajectory)) {
+    throw Error("external result: trajectory " + trajectory.string() + " is not a file");
+  }
+  if (depth_stride_px < 1) throw Error("external result: depth_stride_px must be >= 1");
+}
+
+nlohmann::json ToJson(const ExternalResult& result) {
+  return {{"name", result.name},
+          {"estimates", fs::absolute(result.estimates).string()},
+          {"trajectory", result.trajectory.empty() ? "" : fs::absolute(result.trajectory).string()},
+          {"depth_stride_px", result.depth_stride_px}};
+}
+
+RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& result,
+                               const EvaluationOptions& evaluation, const fs::path& out) {
+  result.Check();
+  evaluation.Check();
+  const SequenceReader reader(sequence);
+  const SequenceInfo& info = reader.info();
+  const cv::Size size(info.camera.width(), info.camera.height());
+  const FrameEstimates estimates = fs::is_directory(result.estimates)
+                                       ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
+                                       : ReadPointsCsv(result.estimates, reader.frame_count());
+  const std::map<int, Rigid3> poses =
+      result.trajectory.empty() ? std::map<int, Rigid3>{} : ReadTrajectory(result.trajectory, info.fps, reader.frame_count());
+
+  RunFolderStreams streams =
+      BeginRunFolder(out, sequence, {{"sequence_info", info}, {"external", ToJson(result)}, {"evaluation", evaluation}});
+  std::ofstream& points_csv = streams.points;
+  std::ofstream& metrics_csv = streams.metrics;
+
+  RunSummary summary;
+  summary.frames_total = reader.frame_count();
+  std::vector<FrameEvaluation> evaluations;
+  std::vector<StampedPose> trajectory;
+  std::vector<TrajectorySegment> aligned(1);
+  const std::vector<EstimatedPoint> none;
+  for (int frame = 0; frame < reader.frame_count(); ++frame) {
+    const auto found = estimates.find(frame);
+    const std::vector<EstimatedPoint>& points = found == estimates.end() ? none : found->second;
+    const auto pose = poses.find(frame);
+    const bool tracked = !points.empty() || pose != poses.end();
+    FrameEvaluation frame_evaluation;
+    if (tracked) {
+      ++summary.frames_tracked;
+      if (summary.init_frame < 0) summary.init_frame = frame;
+      summary.maps = 1;  // one map: another system's figures are not split by its re-initialisations
+      summary.stop_frame = -1;
+      summary.stop_reason.clear();
+      std::vector<DepthPoint> depth_points;
+      for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
+      if (reader.has_depth() && !points.empty()) {
+        frame_evaluation = EvaluateFrame(depth_points, reader.ReadDepthMm(frame), evaluation);
+        if (frame_evaluation.evaluated) evaluations.push_back(frame_evaluation);
+      }
+      std::vector<std::pair<cv::Point2f, double>> splats;
+      const double to_mm = frame_evaluation.evaluated ? frame_evaluation.scale : 1.0;
+      for (const EstimatedPoint& point : points) {
+        points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
+        const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));
+        if (pose != poses.end() && ray.z() > 1e-9) {
+          const Eigen::Vector3d world = pose->second * (ray * (point.depth / ray.z()));
+          points_csv << world.x() << ',' << world.y() << ',' << world.z();
+        } else {
+          points_csv << ",,";  // no pose: no world position
+        }
+        points_csv << ",tracked\n";
+        splats.emplace_back(cv::Point2f(static_cast<float>(point.pixel.x), static_cast<float>(point.pixel.y)),
+                            to_mm * point.depth);
+      }
+      const fs::path depth_file = out / "depth" / FrameFileName(frame);
+      if (!cv::imwrite(depth_file.string(), SplatDepth(splats, size, info.depth_unit_mm))) {
+        throw Error("cannot write " + depth_file.string());
+      }
+      if (pose != poses.end()) {
+        trajectory.push_back({frame / info.fps, pose->second});
+        if (reader.has_groundtruth()) {
+          aligned[0].estimated.push_back(pose->second.translation);
+          aligned[0].groundtruth.push_back(reader.groundtruth()[static_cast<size_t>(frame)].world_from_camera.translation);
+        }
+      }
+    } else {
+      if (summary.init_frame >= 0) ++summary.frames_lost;
+      if (summary.stop_frame < 0) summary.stop_frame = frame;
+      summary.stop_reason = "no estimate in " + result.estimates.filename().string();
+    }
+    const TrackingState state = tracked ? TrackingState::kTracking
+                                : summary.init_frame < 0 ? TrackingState::kNotInitialised
+                                                         : TrackingState::kLost;
+    metrics_csv << frame << ',' << ToString(state) << ',' << summary.maps << ',' << points.size() << ",0,0,0,0,0,0,0,0,"
+                << frame_evaluation.points_without_groundtruth << ','
+                << (frame_evaluation.evaluated ? frame_evaluation.scale : 0.0) << ','
+                << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
+                << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
+                << ",0,0,0,0,0,0,0,0,\"" << (tracked ? "" : "no estimate") << "\"\n";
+  }
+  AggregateInto(&summary, evaluations, aligned);
+  WriteTum(out / "trajectory.tum", trajectory);
+  WriteSummaryJson(out / "summary.json", summary, {{"init", "external"}, {"mapping", nullptr}, {"mode", "external"}});
+  return summary;
+}
+
+}  // namespace nrslam

@@ -1,0 +1,121 @@
+#include "nrslam/system/run_files.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+
+std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason) {
+  if (reason.empty()) return "";
+  if (init_frame < 0) return "never initialised: " + reason;
+  return "lost from frame " + std::to_string(stop_frame) + ": " + reason;
+}
+
+std::string RunSummary::Status() const {
+  if (init_frame < 0) return "not_initialised";
+  return stop_frame >= 0 ? "lost" : "ok";
+}
+
+std::string DescribeSummary(const RunSummary& summary) {
+  std::ostringstream text;
+  text << "frames tracked " << summary.frames_tracked << "/" << summary.frames_total << " (init at " << summary.init_frame
+       << ", lost " << summary.frames_lost << ")  ";
+  if (summary.frames_evaluated > 0) {
+    text << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
+         << summary.rmse_flat_mm << " mm)  ";
+  } else {
+    text << "no ground truth, no RMSE  ";
+  }
+  if (summary.trajectory_error.evaluated) text << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
+  if (summary.fps > 0) text << summary.fps << " fps";
+  const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
+  if (!stop.empty()) text << '\n' << stop;
+  return text.str();
+}
+
+void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& frames,
+                   const std::vector<TrajectorySegment>& maps) {
+  const SequenceMetrics metrics = AggregateFrames(frames);
+  summary->rmse_mm = metrics.rmse_mm;
+  summary->rmse_median_mm = metrics.rmse_median_mm;
+  summary->rmse_pooled_mm = metrics.rmse_pooled_mm;
+  summary->rmse_flat_mm = metrics.rmse_flat_mm;
+  summary->frames_evaluated = metrics.frames_evaluated;
+  summary->trajectory_error = AlignedTrajectoryError(maps);
+}
+
+RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::filesystem::path& sequence,
+                                const nlohmann::json& config) {
+  std::error_code error;
+  std::filesystem::create_directories(out / "depth", error);
+  if (error) throw Error("cannot create " + out.string() + ": " + error.message());
+  {
+    nlohmann::json written{{"nrslam_version", NRSLAM_VERSION}, {"sequence", std::filesystem::absolute(sequence).string()}};
+    written.update(config);
+    std::ofstream file = OpenForWriting(out / "config.json");
+    file << written.dump(2) << '\n';
+  }
+  RunFolderStreams streams{OpenForWriting(out / "points.csv"), OpenForWriting(out / "metrics.csv")};
+  streams.points << kPointsCsvHeader << '\n';
+  streams.metrics << kMetricsCsvHeader << '\n';
+  return streams;
+}
+
+std::ofstream OpenForWriting(const std::filesystem::path& path) {
+  std::ofstream file(path);
+  if (!file) throw Error("cannot write " + path.string());
+  file << std::setprecision(9);
+  return file;
+}
+
+cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, const cv::Size& size, double unit_mm) {
+  cv::Mat depth = cv::Mat::zeros(size, CV_16UC1);
+  for (const auto& [pixel, depth_mm] : points) {
+    const double value = std::round(depth_mm / unit_mm);
+    if (!(value > 0) || value > 65535) continue;
+    const int cx = cvRound(pixel.x), cy = cvRound(pixel.y);
+    for (int y = std::max(0, cy - 1); y <= std::min(size.height - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(size.width - 1, cx + 1); ++x) {
+        depth.at<uint16_t>(y, x) = static_cast<uint16_t>(value);
+      }
+    }
+  }
+  return depth;
+}
+
+void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summary, const nlohmann::json& provenance) {
+  const TrajectoryError& trajectory_error = summary.trajectory_error;
+  nlohmann::json json{{"rmse_mm", summary.rmse_mm},
+                      {"rmse_median_mm", summary.rmse_median_mm},
+                      {"rmse_pooled_mm", summary.rmse_pooled_mm},
+                      {"rmse_flat_mm", summary.rmse_flat_mm},
+                      {"frames_tracked", summary.frames_tracked},
+                      {"frames_total", summary.frames_total},
+                      {"frames_lost", summary.frames_lost},
+                      {"frames_evaluated", summary.frames_evaluated},
+                      {"init_frame", summary.init_frame},
+                      {"fps", summary.fps},
+                      {"ms_per_frame", {{"initialisation", summary.ms_initialisation},
+                                        {"tracking", summary.ms_tracking},
+                                        {"tracking_linear_solve", summary.ms_tracking_linear_solve},
+                                        {"dba", summary.ms_dba},
+                                        {"triangulation", summary.ms_triangulation}}},
+                      {"maps", summary.maps},
+                      // null without ground-truth poses or a moving camera
+                      {"ate_rmse_mm", trajectory_error.evaluated ? nlohmann::json(trajectory_error.rmse_mm) : nlohmann::json()},
+                      {"ate_scale", trajectory_error.evaluated ? nlohmann::json(trajectory_error.scale) : nlohmann::json()},
+                      {"ate_frames", trajectory_error.poses},
+                      {"map_points", summary.map_points}};
+  json.update(provenance);
+  json["status"] = summary.Status();
+  json["stop_frame"] = summary.stop_frame >= 0 ? nlohmann::json(summary.stop_frame) : nlohmann::json();
+  json["stop_reason"] = summary.stop_frame >= 0 ? nlohmann::json(summary.stop_reason) : nlohmann::json();
+  std::ofstream file = OpenForWriting(path);
+  file << json.dump(2) << '\n';
+}
+
+}  // namespace nrslam

@@ -1,0 +1,81 @@
+// system: the files of a run folder that every producer of one writes the same way (the
+// runner, and the scorer of another system's output): their CSV headers, the estimated depth
+// images, and summary.json with the run's aggregates and how it ended.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/eval/trajectory_error.h"
+
+namespace nrslam {
+
+inline constexpr const char* kPointsCsvHeader = "frame,point_id,u,v,z_est,x,y,z,status";
+inline constexpr const char* kMetricsCsvHeader =
+    "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,"
+    "deformable_candidates,new_points,points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,"
+    "ms_dba,ms_triangulation,ms_total,ms_joint_solve,ms_linear_solve,note";
+
+struct RunSummary {
+  double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
+  double rmse_flat_mm = 0;  // the same points all at one depth (eval/depth_evaluation.h)
+  int frames_tracked = 0;  // frames with a pose after initialisation (the paper's "# Fr.")
+  int frames_total = 0;
+  int frames_lost = 0;
+  int init_frame = -1;
+  int frames_evaluated = 0;
+  double fps = 0;          // frames processed per second of wall time (reading included)
+  // Mean milliseconds per processed frame in each stage (the mapping stages run on some frames only).
+  double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
+  double ms_tracking_linear_solve = 0;  // of ms_tracking: the joint solves' linear solver
+  TrajectoryError trajectory_error;  // camera centres aligned to the ground-truth poses per map
+  int maps = 0;            // maps started (a monocular run starts a new one after a loss)
+  size_t map_points = 0;   // points in the last map
+  // A run that ends without tracking: the first frame of that final stretch and its note (why
+  // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.
+  int stop_frame = -1;
+  std::string stop_reason;
+  // "ok", "lost" (the run ends without tracking) or "not_initialised".
+  std::string Status() const;
+};
+
+// How a run that ends without tracking stopped: "lost from frame 12: only 7 points left after
+// outlier rejection" or "never initialised: …"; "" when `reason` is empty (it ends tracking).
+std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason);
+
+// The summary's figures: the depth aggregates of the evaluated frames and the trajectory error
+// of the tracked camera centres (one segment per map).
+void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& frames,
+                   const std::vector<TrajectorySegment>& maps);
+
+// A run folder begun: `out` and `out`/depth created, config.json written (the version, the
+// sequence's absolute path, then `config`'s keys), points.csv and metrics.csv opened with
+// their headers. Throws Error if any of it cannot be written.
+struct RunFolderStreams {
+  std::ofstream points, metrics;
+};
+RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::filesystem::path& sequence,
+                                const nlohmann::json& config);
+
+// What a run did, in one or two lines (as nrslam_run prints it): frames tracked, RMSE,
+// trajectory error, fps (when measured), and how it stopped.
+std::string DescribeSummary(const RunSummary& summary);
+
+// A text file for the run folder, numbers at 9 significant digits; throws Error if it cannot be opened.
+std::ofstream OpenForWriting(const std::filesystem::path& path);
+
+// Estimated depth image: each point a 3x3 splat of its depth (mm), 16-bit in `unit_mm`.
+cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, const cv::Size& size, double unit_mm);
+
+// summary.json: the summary's figures under the key names of design §5, plus `provenance`'s
+// keys (how the run was made: init, mapping, mode).
+void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summary, const nlohmann::json& provenance);
+
+}  // namespace nrslam
