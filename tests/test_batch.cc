@@ -24,7 +24,7 @@ namespace nrslam {
 namespace {
 
 const Programs kPrograms{NRSLAM_TOOLS_DIR "/nrslam_simulate", NRSLAM_TOOLS_DIR "/nrslam_run",
-                         NRSLAM_TOOLS_DIR "/nrslam_import"};
+                         NRSLAM_TOOLS_DIR "/nrslam_import", NRSLAM_TOOLS_DIR "/nrslam_eval"};
 
 std::filesystem::path WriteFile(const std::filesystem::path& file, const std::string& text) {
   std::filesystem::create_directories(file.parent_path());
@@ -519,6 +519,62 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   std::filesystem::remove_all(folder);
 }
 
+// Another system's output on a sequence of the manifest is scored, not run, and sits in the
+// same table: here a run's own output given back as if it came from elsewhere.
+TEST(BatchEvaluation, AnExternalResultIsScoredBesideTheRuns) {
+  const auto folder = UniqueTempFolder("batch_external");
+  const Manifest ours = LoadManifest(WriteFile(folder / "ours.json", std::string(R"({
+    "defaults": {"init": "depth", "simulate": )") + kTinySimulate + R"(},
+    "sequences": [{"name": "s", "preset": "sim-1"}]})"));
+  const EvaluationPlan first = PlanEvaluation(ours, {}, {}, folder / "ours", folder / "cache");
+  ExecutePlan(first, kPrograms, 2, [](const std::string&) {});
+  const RunResult own = CollectResults(first)[0];
+  ASSERT_EQ(own.status, "ok") << own.error;
+  const std::string run = (folder / "ours" / "runs" / "s").string();
+  const Manifest both = LoadManifest(WriteFile(folder / "both.json", std::string(R"({
+    "defaults": {"init": "depth", "set": {"k": 2}, "simulate": )") + kTinySimulate + R"(},
+    "sequences": [
+      {"name": "s", "preset": "sim-1"},
+      {"name": "s-elsewhere", "preset": "sim-1",
+       "external": {"estimates": ")" + run + R"(/points.csv", "trajectory": ")" + run +
+                                                   R"(/trajectory.tum", "name": "ours, again"}}
+    ]})"));
+  // The defaults' run settings do not apply to it, and a sweep scores it once.
+  const EvaluationPlan plan = PlanEvaluation(both, {}, {ParseSweep("k=1,2")}, folder / "out", folder / "cache");
+  ASSERT_EQ(plan.runs.size(), 3u);
+  const RunJob& external = plan.runs[2];
+  EXPECT_TRUE(external.label.empty());
+  EXPECT_EQ(external.prepare, plan.runs[0].prepare);  // the same rendered sequence
+  const std::string line = RunShellLine(plan, external, kPrograms);
+  EXPECT_NE(line.find("nrslam_eval score "), std::string::npos) << line;
+  ExecutePlan(plan, kPrograms, 2, [](const std::string&) {});
+  const std::vector<RunResult> results = CollectResults(plan);
+  ASSERT_EQ(results.size(), 3u);
+  EXPECT_EQ(results[2].status, "ok") << results[2].error;
+  EXPECT_EQ(results[2].frames_tracked, own.frames_tracked);
+  EXPECT_NEAR(results[2].rmse_mm, own.rmse_mm, 1e-5);
+  EXPECT_NEAR(results[2].ate_mm, own.ate_mm, 1e-4);
+  EXPECT_EQ(results[2].fps, 0.0);
+  std::stringstream table;
+  PrintResults(results, table);
+  EXPECT_NE(table.str().find("s-elsewhere"), std::string::npos) << table.str();
+  EXPECT_TRUE(CompareWithRigid(plan, results).empty());
+  std::vector<std::string> lines;
+  ExecutePlan(plan, kPrograms, 2, [&](const std::string& text) { lines.push_back(text); });
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "3 run(s) already finished, not run again");
+  // Run settings on it are refused, and so are estimates that are not there.
+  EXPECT_NE(ErrorOf(WriteFile(folder / "rigid.json", R"({"sequences": [{"name": "x", "preset": "sim-1",
+              "rigid": true, "external": {"estimates": "points.csv"}}]})"))
+                .find("\"rigid\" configures an NR-SLAM run"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(WriteFile(folder / "missing.json", R"({"sequences": [{"name": "x", "preset": "sim-1",
+              "external": {"estimates": "nowhere.csv"}}]})"))
+                .find("nowhere.csv does not exist"),
+            std::string::npos);
+  std::filesystem::remove_all(folder);
+}
+
 // A Hamlyn-layout copy of a short simulated sequence (left images, 16-bit depth in mm,
 // intrinsics.txt), as a user would have the real dataset on disk.
 void WriteHamlynLayout(const std::filesystem::path& folder, int frames) {
@@ -585,13 +641,13 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   const auto folder = UniqueTempFolder("batch_crash");
   EvaluationPlan plan;
   const std::filesystem::path crasher = StandInRunner(folder, "echo about to crash\nkill -SEGV $$\n", 2, &plan);
-  ExecutePlan(plan, Programs{kPrograms.simulate, crasher, kPrograms.import}, 2, [](const std::string&) {});
+  ExecutePlan(plan, Programs{kPrograms.simulate, crasher, kPrograms.import, kPrograms.eval}, 2, [](const std::string&) {});
   for (const RunResult& result : CollectResults(plan)) {
     EXPECT_EQ(result.status, "failed");
     EXPECT_NE(result.error.find("killed by signal 11"), std::string::npos) << result.error;
     EXPECT_NE(result.error.find("about to crash"), std::string::npos) << result.error;  // its last words
   }
-  ExecutePlan(plan, Programs{kPrograms.simulate, folder / "no-such-program", kPrograms.import}, 2,
+  ExecutePlan(plan, Programs{kPrograms.simulate, folder / "no-such-program", kPrograms.import, kPrograms.eval}, 2,
               [](const std::string&) {});
   for (const RunResult& result : CollectResults(plan)) {
     EXPECT_EQ(result.status, "failed");
@@ -605,7 +661,7 @@ TEST(BatchEvaluation, ARunThatHangsIsKilledAtItsTimeoutAndRecorded) {
   EvaluationPlan plan;
   const std::filesystem::path hanger = StandInRunner(folder, "exec sleep 600\n", 3, &plan);
   const auto start = std::chrono::steady_clock::now();
-  ExecutePlan(plan, Programs{kPrograms.simulate, hanger, kPrograms.import}, 2, [](const std::string&) {}, 1.0);
+  ExecutePlan(plan, Programs{kPrograms.simulate, hanger, kPrograms.import, kPrograms.eval}, 2, [](const std::string&) {}, 1.0);
   // Three runs of 1 s, two at a time: about two seconds, not the 600 s each would take.
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
   for (const RunResult& result : CollectResults(plan)) {

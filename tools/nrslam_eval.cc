@@ -31,7 +31,7 @@ nrslam::Programs SiblingPrograms() {
   std::error_code error;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
   const std::filesystem::path folder = error ? std::filesystem::path(".") : self.parent_path();
-  return {folder / "nrslam_simulate", folder / "nrslam_run", folder / "nrslam_import"};
+  return {folder / "nrslam_simulate", folder / "nrslam_run", folder / "nrslam_import", folder / "nrslam_eval"};
 }
 
 // Exit codes: 0 all well, 1 bad usage or input, 2 some run failed, 3 baseline check failed.

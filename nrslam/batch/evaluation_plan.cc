@@ -115,6 +115,22 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
       }
       folder = job.folder;
     }
+    if (sequence.is_external()) {
+      RunJob run;
+      run.sequence = sequence.name;
+      run.sequence_folder = folder;
+      run.run_folder = out_folder / "runs" / sequence.name;
+      run.prepare = prepare;
+      run.external = ToJson(sequence.external);
+      run.arguments = {"score", folder.string(), sequence.external.estimates.string(), "--out", run.run_folder.string(),
+                       "--stride", std::to_string(sequence.external.depth_stride_px)};
+      if (!sequence.external.trajectory.empty()) {
+        run.arguments.insert(run.arguments.end(), {"--trajectory", sequence.external.trajectory.string()});
+      }
+      if (!sequence.external.name.empty()) run.arguments.insert(run.arguments.end(), {"--name", sequence.external.name});
+      plan.runs.push_back(std::move(run));
+      continue;
+    }
     for (const auto& point : points) {
       RunJob run;
       run.sequence = sequence.name;
@@ -152,6 +168,10 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
 
 namespace {
 
+const std::filesystem::path& ProgramOf(const RunJob& run, const Programs& programs) {
+  return run.external.is_null() ? programs.run : programs.eval;
+}
+
 std::vector<std::string> PrepareCommand(const PrepareJob& prepare, const Programs& programs) {
   std::vector<std::string> argv = {(prepare.import ? programs.import : programs.simulate).string()};
   argv.insert(argv.end(), prepare.arguments.begin(), prepare.arguments.end());
@@ -172,7 +192,7 @@ std::string PrepareShellLine(const PrepareJob& prepare, const Programs& programs
 }
 
 std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Programs& programs) {
-  std::vector<std::string> argv = {programs.run.string()};
+  std::vector<std::string> argv = {ProgramOf(run, programs).string()};
   argv.insert(argv.end(), run.arguments.begin(), run.arguments.end());
   const std::string command = ShellLine(argv);
   if (run.prepare < 0) return command;
@@ -183,11 +203,13 @@ bool RunIsFinished(const RunJob& run) {
   if (!std::filesystem::exists(run.run_folder / "summary.json")) return false;
   try {
     const Json config = ReadJsonFile(run.run_folder / "config.json");
+    const bool same_sequence =
+        config.at("sequence").get<std::string>() == std::filesystem::absolute(run.sequence_folder).string();
+    if (!run.external.is_null()) return config.value("external", Json()) == run.external && same_sequence;
     // Parsed back through the options struct, so that a config written before an option
     // existed compares as that option's default.
     const Json options = OptionsFromJson<SystemOptions>(config.at("options"), "config.json");
-    return options == run.options &&
-           config.at("sequence").get<std::string>() == std::filesystem::absolute(run.sequence_folder).string();
+    return options == run.options && same_sequence;
   } catch (const std::exception&) {
     return false;  // unreadable, or from a version with options this one lacks: run it again
   }
@@ -243,7 +265,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
       continue;
     }
     std::filesystem::create_directories(run.run_folder.parent_path());
-    Command command{{programs.run.string()}, run.run_folder.string() + ".log", run_timeout_seconds};
+    Command command{{ProgramOf(run, programs).string()}, run.run_folder.string() + ".log", run_timeout_seconds};
     command.argv.insert(command.argv.end(), run.arguments.begin(), run.arguments.end());
     runs.push_back(command);
     run_index.push_back(i);

@@ -34,8 +34,11 @@ struct RunJob {
   std::string label;                         // "k=0.5,max_degree_D=3", or "" without sweeps
   std::filesystem::path sequence_folder;
   std::filesystem::path run_folder;          // out/runs/<sequence>[/<label>]
-  std::vector<std::string> arguments;        // nrslam_run's arguments (no program name)
-  Json options;                              // the options those arguments resolve to
+  std::vector<std::string> arguments;        // the program's arguments (no program name)
+  Json options;                              // the options those arguments resolve to (null: external)
+  // An external result scored by `nrslam_eval score` instead of an nrslam_run: what its
+  // config.json records (ToJson of system/external_result.h); null for a run of ours.
+  Json external;
   int prepare = -1;                          // index into EvaluationPlan::prepares, or -1
 };
 
@@ -44,7 +47,7 @@ struct EvaluationPlan {
   std::vector<RunJob> runs;
 };
 
-// Expands the manifest × the sweep grid; `extra` assignments apply to every run (after the
+// Expands the manifest × the sweep grid (an external result is scored once, at no sweep point); `extra` assignments apply to every run (after the
 // manifest's). Validates every run's options.
 EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::string>& extra,
                               const std::vector<Sweep>& sweeps, const std::filesystem::path& out,
@@ -54,6 +57,7 @@ struct Programs {
   std::filesystem::path simulate;  // nrslam_simulate
   std::filesystem::path run;       // nrslam_run
   std::filesystem::path import;    // nrslam_import
+  std::filesystem::path eval;      // nrslam_eval, which scores external results
 };
 
 // The shell command that prepares a sequence into the cache (atomically, so concurrent or

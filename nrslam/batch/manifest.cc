@@ -13,7 +13,10 @@ namespace {
 
 // The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).
 const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "import", "simulate", "set", "init",
-                                             "rigid", "first_frame", "last_frame", "camera"};
+                                             "rigid", "first_frame", "last_frame", "camera", "external"};
+// The keys that configure an NR-SLAM run, which an external result does not have.
+const std::set<std::string> kRunKeys = {"set", "init", "rigid", "first_frame", "last_frame", "camera"};
+const std::set<std::string> kExternalKeys = {"estimates", "trajectory", "stride", "name"};
 
 // The keys of an "import" object: nrslam_import's options by their long names.
 const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
@@ -21,6 +24,37 @@ const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps
 
 void Require(bool condition, const std::string& context, const std::string& message) {
   if (!condition) throw Error(context + ": " + message);
+}
+
+std::filesystem::path FromManifest(const std::string& path, const std::filesystem::path& folder) {
+  std::filesystem::path file(path);
+  if (file.is_relative()) file = folder / file;
+  return file.lexically_normal();
+}
+
+ExternalResult ParseExternal(const Json& entry, const std::filesystem::path& folder, const std::string& context) {
+  for (const std::string& key : kRunKeys) {
+    Require(!entry.contains(key), context, "\"" + key + "\" configures an NR-SLAM run; an \"external\" result is scored as it is");
+  }
+  const Json& external = entry["external"];
+  Require(external.is_object() && external.contains("estimates") && external["estimates"].is_string(), context,
+          "\"external\" needs at least \"estimates\" (a CSV file or a folder of depth images)");
+  ExternalResult result;
+  for (const auto& [key, value] : external.items()) {
+    Require(kExternalKeys.count(key) > 0, context, "external: unknown key '" + key + "'");
+    Require(key == "stride" ? value.is_number_integer() : value.is_string(), context,
+            "external: \"" + key + "\" must be " + (key == "stride" ? "an integer" : "a string"));
+  }
+  result.estimates = FromManifest(external["estimates"], folder);
+  if (external.contains("trajectory")) result.trajectory = FromManifest(external["trajectory"], folder);
+  result.depth_stride_px = external.value("stride", result.depth_stride_px);
+  result.name = external.value("name", "");
+  try {
+    result.Check();
+  } catch (const Error& e) {
+    throw Error(context + ": " + e.what());
+  }
+  return result;
 }
 
 // Merges the defaults under an entry: objects ("set", "simulate") key by key, the rest whole.
@@ -99,6 +133,10 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
       }
     }
   }
+  if (entry.contains("external")) {
+    sequence.external = ParseExternal(entry, folder, context);
+    return sequence;
+  }
   if (entry.contains("set")) {
     Require(entry["set"].is_object(), context, "\"set\" must be an object of run options");
     for (const auto& [key, value] : entry["set"].items()) {
@@ -165,8 +203,13 @@ Manifest LoadManifest(const std::filesystem::path& file) {
                                      ? " ('" + entries[i]["name"].get<std::string>() + "')"
                                      : "");
     Require(entries[i].is_object(), context, "each sequence must be a JSON object");
+    // The defaults' run settings are for the runs; an external result has none.
+    Json entry_defaults = defaults;
+    if (entries[i].contains("external")) {
+      for (const std::string& key : kRunKeys) entry_defaults.erase(key);
+    }
     ManifestSequence sequence =
-        ParseSequence(WithDefaults(defaults, entries[i]), manifest.file.parent_path(), context);
+        ParseSequence(WithDefaults(entry_defaults, entries[i]), manifest.file.parent_path(), context);
     Require(names.insert(sequence.name).second, context, "the name '" + sequence.name + "' is used twice");
     manifest.sequences.push_back(std::move(sequence));
   }

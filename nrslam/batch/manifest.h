@@ -6,7 +6,8 @@
 //     "sequences": [
 //       {"name": "sim-3", "preset": "sim-3", "simulate": {"camera.width": 320, "camera.height": 240}},
 //       {"name": "mine", "path": "../data/mine", "first_frame": 10, "last_frame": 200, "rigid": true},
-//       {"name": "h01", "import": {"format": "hamlyn", "path": "/data/hamlyn/rectified01"}}
+//       {"name": "h01", "import": {"format": "hamlyn", "path": "/data/hamlyn/rectified01"}},
+//       {"name": "sim-3-defslam", "preset": "sim-3", "external": {"estimates": "defslam/sim-3.csv"}}
 //     ]
 //   }
 //
@@ -16,13 +17,18 @@
 // long name, e.g. "calibration", "max_frames", "scene_unit_mm"); presets and imports are
 // made on demand into a cache. Per sequence and in `defaults`: `set` (run options by
 // their nrslam_run --set path, or by a unique last name such as "k"), `init`, `rigid`,
-// `first_frame`, `last_frame`, `camera` (a camera JSON used instead of the sequence's). Everything is validated when the manifest is loaded.
+// `first_frame`, `last_frame`, `camera` (a camera JSON used instead of the sequence's).
+// A sequence with `external` is not run: another system's output on it is scored
+// (system/external_result.h; keys "estimates", "trajectory", "stride", "name", paths relative to
+// the manifest), so baselines sit in the same table; run options do not apply to it.
+// Everything is validated when the manifest is loaded.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "nrslam/system/external_result.h"
 #include "nrslam/util/json_options.h"
 
 namespace nrslam {
@@ -35,6 +41,8 @@ struct ManifestSequence {
   std::vector<std::string> import;        // nrslam_import arguments (no --out), or empty
   std::vector<std::string> assignments;   // run assignments "module.option=value"
   bool rigid = false;
+  ExternalResult external;                // scored instead of run when its estimates are given
+  bool is_external() const { return !external.estimates.empty(); }
 };
 
 struct Manifest {

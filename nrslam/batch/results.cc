@@ -209,7 +209,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
       row.insert(row.end(), {r.status, std::to_string(r.init_frame),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
                              RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), FlatRmseCell(r), AteCell(r.ate_mm),
-                             FormatFixed(r.fps, 1)});
+                             r.fps > 0 ? FormatFixed(r.fps, 1) : "-"});  // an external result has none
     }
     table.AddRow(row);
   }
