@@ -207,12 +207,15 @@ TEST_F(RunSequenceTest, ExternalDepthImagesScoreAsKnown) {
   const SequenceReader reader(*base_ / "sequence");
   const fs::path images = *base_ / "half_depth";
   fs::create_directories(images);
+  setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
   for (int frame = 0; frame < 10; ++frame) {
     if (frame == 5) continue;
     cv::Mat half;
     reader.ReadDepthMm(frame).convertTo(half, CV_32F, 0.5);
-    ASSERT_TRUE(cv::imwrite((images / ("estimate_" + std::to_string(frame) + ".tiff")).string(), half));
+    const std::string format = frame == 9 ? ".exr" : ".tiff";  // both kinds a depth network writes
+    ASSERT_TRUE(cv::imwrite((images / ("estimate_" + std::to_string(frame) + format)).string(), half));
   }
+  std::ofstream(images / "notes.txt") << "not an estimate\n";
   ExternalResult external;
   external.estimates = images;
   external.depth_stride_px = 4;

@@ -111,9 +111,15 @@ std::optional<int> FrameNumberOf(const std::string& stem) {
 }
 
 FrameEstimates ReadDepthImages(const fs::path& folder, const cv::Size& size, int stride, int frame_count) {
+  // OpenCV 4.6 reads EXR only when asked to (CVE hardening), and depth networks write EXR.
+  setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
   std::vector<fs::path> files;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
-    if (entry.is_regular_file() && entry.path().filename().string().front() != '.') files.push_back(entry.path());
+    // Files OpenCV has no reader for (notes, calibration, hidden files) are not estimates.
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && name.front() != '.' && cv::haveImageReader(entry.path().string())) {
+      files.push_back(entry.path());
+    }
   }
   std::sort(files.begin(), files.end());
   FrameEstimates estimates;

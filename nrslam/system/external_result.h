@@ -15,6 +15,7 @@
 //   - a folder of single-channel depth images readable by OpenCV (16-bit PNG, float TIFF or
 //     EXR), one per frame, the frame number the last number in the file name. They are sampled
 //     every `depth_stride_px` pixels; 0, negative and non-finite values are "no estimate".
+//     Files that are not images OpenCV reads (notes, a calibration) are skipped.
 // A frame with neither points nor a pose counts as not tracked.
 #pragma once
 
