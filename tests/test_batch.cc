@@ -531,17 +531,19 @@ TEST(BatchEvaluation, AnExternalResultIsScoredBesideTheRuns) {
   const RunResult own = CollectResults(first)[0];
   ASSERT_EQ(own.status, "ok") << own.error;
   const std::string run = (folder / "ours" / "runs" / "s").string();
+  WriteFile(folder / "nothing.csv", "frame,u,v,z\n");  // a system that estimated nothing
   const Manifest both = LoadManifest(WriteFile(folder / "both.json", std::string(R"({
     "defaults": {"init": "depth", "set": {"k": 2}, "simulate": )") + kTinySimulate + R"(},
     "sequences": [
       {"name": "s", "preset": "sim-1"},
       {"name": "s-elsewhere", "preset": "sim-1",
        "external": {"estimates": ")" + run + R"(/points.csv", "trajectory": ")" + run +
-                                                   R"(/trajectory.tum", "name": "ours, again"}}
+                                                   R"(/trajectory.tum", "name": "ours, again"}},
+      {"name": "s-nothing", "preset": "sim-1", "external": {"estimates": "nothing.csv"}}
     ]})"));
   // The defaults' run settings do not apply to it, and a sweep scores it once.
   const EvaluationPlan plan = PlanEvaluation(both, {}, {ParseSweep("k=1,2")}, folder / "out", folder / "cache");
-  ASSERT_EQ(plan.runs.size(), 3u);
+  ASSERT_EQ(plan.runs.size(), 4u);
   const RunJob& external = plan.runs[2];
   EXPECT_TRUE(external.label.empty());
   EXPECT_EQ(external.prepare, plan.runs[0].prepare);  // the same rendered sequence
@@ -549,8 +551,9 @@ TEST(BatchEvaluation, AnExternalResultIsScoredBesideTheRuns) {
   EXPECT_NE(line.find("nrslam_eval score "), std::string::npos) << line;
   ExecutePlan(plan, kPrograms, 2, [](const std::string&) {});
   const std::vector<RunResult> results = CollectResults(plan);
-  ASSERT_EQ(results.size(), 3u);
+  ASSERT_EQ(results.size(), 4u);
   EXPECT_EQ(results[2].status, "ok") << results[2].error;
+  EXPECT_EQ(results[3].status, "not_initialised") << results[3].error;
   EXPECT_EQ(results[2].frames_tracked, own.frames_tracked);
   EXPECT_NEAR(results[2].rmse_mm, own.rmse_mm, 1e-5);
   EXPECT_NEAR(results[2].ate_mm, own.ate_mm, 1e-4);
@@ -562,7 +565,7 @@ TEST(BatchEvaluation, AnExternalResultIsScoredBesideTheRuns) {
   std::vector<std::string> lines;
   ExecutePlan(plan, kPrograms, 2, [&](const std::string& text) { lines.push_back(text); });
   ASSERT_FALSE(lines.empty());
-  EXPECT_EQ(lines[0], "3 run(s) already finished, not run again");
+  EXPECT_EQ(lines[0], "4 run(s) already finished, not run again");
   // Run settings on it are refused, and so are estimates that are not there.
   EXPECT_NE(ErrorOf(WriteFile(folder / "rigid.json", R"({"sequences": [{"name": "x", "preset": "sim-1",
               "rigid": true, "external": {"estimates": "points.csv"}}]})"))

@@ -261,6 +261,10 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
   fs::create_directories(images.estimates);
   cv::imwrite((images.estimates / "000000.png").string(), cv::Mat(10, 10, CV_16UC1, cv::Scalar(100)));
   EXPECT_THROW(ScoreExternalResult(*base_ / "sequence", images, EvaluationOptions{}, *base_ / "scored_bad"), Error);
+  const fs::path empty = *base_ / "empty_folder";
+  fs::create_directories(empty);
+  images.estimates = empty;
+  EXPECT_THROW(ScoreExternalResult(*base_ / "sequence", images, EvaluationOptions{}, *base_ / "scored_bad"), Error);
   images.estimates = *base_ / "missing";
   EXPECT_THROW(ScoreExternalResult(*base_ / "sequence", images, EvaluationOptions{}, *base_ / "scored_bad"), Error);
 }

@@ -124,7 +124,9 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
     try {
       if (std::filesystem::exists(run.run_folder / "summary.json")) {
         ReadFigures(ReadJsonFile(run.run_folder / "summary.json"), &result);
-        result.status = result.frames_tracked + std::max(result.init_frame, 0) >= result.frames_total ? "ok" : "lost";
+        result.status = result.init_frame < 0 ? "not_initialised"
+                        : result.frames_tracked + result.init_frame >= result.frames_total ? "ok"
+                                                                                          : "lost";
       } else if (std::filesystem::exists(run.run_folder / "failure.json")) {
         result.error = ReadJsonFile(run.run_folder / "failure.json").value("error", "unknown failure");
       } else {

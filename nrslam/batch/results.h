@@ -16,7 +16,7 @@ struct RunResult {
   std::string sequence;
   std::string label;                // sweep point, "" without sweeps
   std::vector<std::string> point;   // "path=value" per swept option
-  std::string status = "failed";    // "ok", "lost" (tracking lost before the end) or "failed"
+  std::string status = "failed";    // "ok", "lost" (tracking lost before the end), "not_initialised" or "failed"
   std::string error;                // why it failed
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)

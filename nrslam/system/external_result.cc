@@ -121,6 +121,8 @@ FrameEstimates ReadDepthImages(const fs::path& folder, const cv::Size& size, int
       files.push_back(entry.path());
     }
   }
+  // An empty folder is a wrong path far more often than a system that failed on every frame.
+  if (files.empty()) throw Error(folder.string() + " holds no depth image");
   std::sort(files.begin(), files.end());
   FrameEstimates estimates;
   for (const fs::path& file : files) {
@@ -250,7 +252,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     } else {
       if (summary.init_frame >= 0) ++summary.frames_lost;
       if (summary.stop_frame < 0) summary.stop_frame = frame;
-      summary.stop_reason = "no estimate in " + result.estimates.filename().string();
+      summary.stop_reason = "no estimate of this frame in " + result.estimates.string();
     }
     const TrackingState state = tracked ? TrackingState::kTracking
                                 : summary.init_frame < 0 ? TrackingState::kNotInitialised
