@@ -566,6 +566,14 @@ TEST(BatchEvaluation, AnExternalResultIsScoredBesideTheRuns) {
   ExecutePlan(plan, kPrograms, 2, [&](const std::string& text) { lines.push_back(text); });
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0], "4 run(s) already finished, not run again");
+  // The same path exported again is new output, scored again rather than reported stale.
+  std::ofstream(folder / "nothing.csv", std::ios::app) << "0,100,80,3.5\n";
+  const EvaluationPlan again = PlanEvaluation(both, {}, {ParseSweep("k=1,2")}, folder / "out", folder / "cache");
+  lines.clear();
+  ExecutePlan(again, kPrograms, 2, [&](const std::string& text) { lines.push_back(text); });
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "3 run(s) already finished, not run again");
+  EXPECT_EQ(CollectResults(again)[3].status, "lost");  // frame 0 only, then nothing
   // Run settings on it are refused, and so are estimates that are not there.
   EXPECT_NE(ErrorOf(WriteFile(folder / "rigid.json", R"({"sequences": [{"name": "x", "preset": "sim-1",
               "rigid": true, "external": {"estimates": "points.csv"}}]})"))
@@ -713,7 +721,7 @@ TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
   std::vector<std::string> lines;
   ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   ASSERT_EQ(lines.size(), 2u);
-  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options or another sequence: run again");
+  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options, another sequence or changed estimates: run again");
   EXPECT_NE(lines[1].find("[1/1] s done"), std::string::npos) << lines[1];
   const Json config = ReadJsonFile(plain.runs[0].run_folder / "config.json");
   EXPECT_EQ(config.at("options").at("deformation").at("k"), Json(DeformationModelOptions{}.k));

@@ -272,7 +272,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   }
   if (skipped > 0) progress(std::to_string(skipped) + " run(s) already finished, not run again");
   if (superseded > 0) {
-    progress(std::to_string(superseded) + " run(s) in the output folder had other options or another sequence: run again");
+    progress(std::to_string(superseded) + " run(s) in the output folder had other options, another sequence or changed estimates: run again");
   }
   size_t finished = 0;
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {

@@ -174,11 +174,41 @@ void ExternalResult::Check() const {
   if (depth_stride_px < 1) throw Error("external result: depth_stride_px must be >= 1");
 }
 
+namespace {
+
+// Sizes and modification times of the files given (a folder's: all of its files), so that an
+// output exported again to the same path is not taken for the one scored before.
+std::string Fingerprint(const std::vector<fs::path>& paths) {
+  uintmax_t files = 0, bytes = 0;
+  fs::file_time_type newest{};
+  std::error_code error;
+  const auto add = [&](const fs::path& file) {
+    ++files;
+    bytes += fs::file_size(file, error);
+    newest = std::max(newest, fs::last_write_time(file, error));
+  };
+  for (const fs::path& path : paths) {
+    if (path.empty()) continue;
+    if (!fs::is_directory(path, error)) {
+      add(path);
+      continue;
+    }
+    for (const fs::directory_entry& entry : fs::directory_iterator(path, error)) {
+      if (entry.is_regular_file(error)) add(entry.path());
+    }
+  }
+  return std::to_string(files) + " files, " + std::to_string(bytes) + " bytes, newest at " +
+         std::to_string(newest.time_since_epoch().count());
+}
+
+}  // namespace
+
 nlohmann::json ToJson(const ExternalResult& result) {
   return {{"name", result.name},
           {"estimates", fs::absolute(result.estimates).string()},
           {"trajectory", result.trajectory.empty() ? "" : fs::absolute(result.trajectory).string()},
-          {"depth_stride_px", result.depth_stride_px}};
+          {"depth_stride_px", result.depth_stride_px},
+          {"fingerprint", Fingerprint({result.estimates, result.trajectory})}};
 }
 
 RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& result,

@@ -36,7 +36,8 @@ struct ExternalResult {
   std::string name;                  // what produced it (e.g. "DefSLAM"), recorded in config.json
   void Check() const;
 };
-// What config.json records under "external": the fields, with absolute paths.
+// What config.json records under "external": the fields, with absolute paths, and the
+// files' sizes and modification times (an output exported again is scored again).
 nlohmann::json ToJson(const ExternalResult& result);
 
 // Throws Error for a bad sequence or bad estimates (a missing column, a row that is not
