@@ -163,19 +163,6 @@ std::map<int, Rigid3> ReadTrajectory(const fs::path& file, double fps, int frame
   return poses;
 }
 
-}  // namespace
-
-void ExternalResult::Check() const {
-  if (estimates.empty()) throw Error("external result: no estimates given (a CSV file or a folder of depth images)");
-  if (!fs::exists(estimates)) throw Error("external result: " + estimates.string() + " does not exist");
-  if (!trajectory.empty() && !fs::is_regular_file(trajectory)) {
-    throw Error("external result: trajectory " + trajectory.string() + " is not a file");
-  }
-  if (depth_stride_px < 1) throw Error("external result: depth_stride_px must be >= 1");
-}
-
-namespace {
-
 // Sizes and modification times of the files given (a folder's: all of its files), so that an
 // output exported again to the same path is not taken for the one scored before.
 std::string Fingerprint(const std::vector<fs::path>& paths) {
@@ -202,6 +189,15 @@ std::string Fingerprint(const std::vector<fs::path>& paths) {
 }
 
 }  // namespace
+
+void ExternalResult::Check() const {
+  if (estimates.empty()) throw Error("external result: no estimates given (a CSV file or a folder of depth images)");
+  if (!fs::exists(estimates)) throw Error("external result: " + estimates.string() + " does not exist");
+  if (!trajectory.empty() && !fs::is_regular_file(trajectory)) {
+    throw Error("external result: trajectory " + trajectory.string() + " is not a file");
+  }
+  if (depth_stride_px < 1) throw Error("external result: depth_stride_px must be >= 1");
+}
 
 nlohmann::json ToJson(const ExternalResult& result) {
   return {{"name", result.name},
