@@ -199,6 +199,7 @@ TEST_F(RunSequenceTest, ScoringTheRunsOwnOutputAsAnExternalResultGivesItsSummary
   const CommonPointsComparison comparison = CompareRunFolders(*base_ / "run", scored);
   EXPECT_EQ(comparison.frames, summary_->frames_evaluated);
   EXPECT_NEAR(comparison.b_common.rmse_mm, summary_->rmse_mm, 1e-5);
+  EXPECT_NEAR(CompareRunFolders(scored, *base_ / "run").a_own.rmse_mm, summary_->rmse_mm, 1e-5);
 }
 
 // Known answers: depth images that are the ground truth at half scale, for frames 0–9 but 5,
@@ -235,6 +236,8 @@ TEST_F(RunSequenceTest, ExternalDepthImagesScoreAsKnown) {
   EXPECT_NEAR(Number(metrics[3], "scale"), 2.0, 1e-9);
   EXPECT_EQ(metrics[5].at("state"), "lost");
   EXPECT_GT(Number(metrics[3], "points"), 1000);  // 80×60 samples, those on the surface
+  // Its ids number pixels, not points: nothing may pair them with a run's point ids.
+  EXPECT_THROW(CompareRunFolders(*base_ / "run", scored), Error);
 }
 
 TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {

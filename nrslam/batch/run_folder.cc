@@ -58,15 +58,26 @@ RunPoints ReadRunPoints(const std::filesystem::path& run_folder) {
 
 CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const std::filesystem::path& b) {
   const Json config = ReadJsonFile(a / "config.json");
+  const Json other_config = ReadJsonFile(b / "config.json");
+  for (const auto& [folder, json] : {std::pair(a, config), std::pair(b, other_config)}) {
+    // An external result's ids may number pixels or rows (system/external_result.h).
+    if (!json.value("ids_name_points", true)) {
+      throw Error(folder.string() + " has no point ids (depth images, or a CSV without point_id): there are no "
+                  "common points to compare on");
+    }
+  }
   const std::string sequence = config.at("sequence").get<std::string>();
-  const std::string other = ReadJsonFile(b / "config.json").at("sequence").get<std::string>();
+  const std::string other = other_config.at("sequence").get<std::string>();
   if (other != sequence) throw Error("the runs are of different sequences: " + sequence + " and " + other);
   const SequenceReader reader(sequence);
   if (!reader.has_depth()) throw Error("sequence " + sequence + " has no depth to compare against");
-  // Scored as run a scored itself.
-  const auto options = OptionsFromJson<SystemOptions>(config.at("options"), (a / "config.json").string());
+  // Scored as run a scored itself: a run of ours by its options, an external result by its own.
+  const std::string where = (a / "config.json").string();
+  const EvaluationOptions evaluation =
+      config.contains("options") ? OptionsFromJson<SystemOptions>(config.at("options"), where).evaluation
+                                 : OptionsFromJson<EvaluationOptions>(config.value("evaluation", Json::object()), where);
   return CompareOnCommonPoints(ReadRunPoints(a), ReadRunPoints(b), [&](int frame) { return reader.ReadDepthMm(frame); },
-                               options.evaluation);
+                               evaluation);
 }
 
 }  // namespace nrslam

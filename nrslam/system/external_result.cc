@@ -59,6 +59,14 @@ void CheckFrame(double frame, int frame_count, const std::string& where) {
   }
 }
 
+bool CsvHasColumn(const fs::path& file, const std::string& name) {
+  std::ifstream in(file);
+  std::string header;
+  if (!std::getline(in, header)) return false;
+  const std::vector<std::string> columns = SplitCsvLine(header);
+  return std::find(columns.begin(), columns.end(), name) != columns.end();
+}
+
 FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count) {
   std::ifstream in(file);
   if (!in) throw Error("cannot read " + file.string());
@@ -214,14 +222,21 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   const SequenceReader reader(sequence);
   const SequenceInfo& info = reader.info();
   const cv::Size size(info.camera.width(), info.camera.height());
-  const FrameEstimates estimates = fs::is_directory(result.estimates)
-                                       ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
+  // Only a CSV with its own point_id column names points: depth images number pixels, and a
+  // CSV without ids numbers rows. Recorded, so that nothing pairs such ids across runs.
+  const bool is_folder = fs::is_directory(result.estimates);
+  const bool ids_name_points = !is_folder && CsvHasColumn(result.estimates, "point_id");
+  const FrameEstimates estimates = is_folder ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
                                        : ReadPointsCsv(result.estimates, reader.frame_count());
   const std::map<int, Rigid3> poses =
       result.trajectory.empty() ? std::map<int, Rigid3>{} : ReadTrajectory(result.trajectory, info.fps, reader.frame_count());
 
   RunFolderStreams streams =
-      BeginRunFolder(out, sequence, {{"sequence_info", info}, {"external", ToJson(result)}, {"evaluation", evaluation}});
+      BeginRunFolder(out, sequence,
+                     {{"sequence_info", info},
+                      {"external", ToJson(result)},
+                      {"evaluation", evaluation},
+                      {"ids_name_points", ids_name_points}});
   std::ofstream& points_csv = streams.points;
   std::ofstream& metrics_csv = streams.metrics;
 

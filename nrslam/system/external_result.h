@@ -16,7 +16,9 @@
 //     EXR), one per frame, the frame number the last number in the file name. They are sampled
 //     every `depth_stride_px` pixels; 0, negative and non-finite values are "no estimate".
 //     Files that are not images OpenCV reads (notes, a calibration) are skipped.
-// A frame with neither points nor a pose counts as not tracked.
+// A frame with neither points nor a pose counts as not tracked. config.json says whether the
+// ids name points (`ids_name_points`: only a CSV's own point_id column does), which
+// `nrslam_eval compare` requires.
 #pragma once
 
 #include <nlohmann/json.hpp>
