@@ -26,6 +26,7 @@ void Require(bool condition, const std::string& context, const std::string& mess
   if (!condition) throw Error(context + ": " + message);
 }
 
+// A path as the manifest gives it: relative ones are relative to the manifest's folder.
 std::filesystem::path FromManifest(const std::string& path, const std::filesystem::path& folder) {
   std::filesystem::path file(path);
   if (file.is_relative()) file = folder / file;
@@ -94,11 +95,7 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
     for (const auto& [key, value] : import.items()) {
       Require(kImportKeys.count(key) > 0, context, "import: unknown key '" + key + "'");
       std::string text = value.is_string() ? value.get<std::string>() : value.dump();
-      if (key == "path" || key == "calibration") {
-        std::filesystem::path file(text);
-        if (file.is_relative()) file = folder / file;
-        text = file.lexically_normal().string();
-      }
+      if (key == "path" || key == "calibration") text = FromManifest(text, folder).string();
       std::string option = key == "path" ? "in" : key;
       std::replace(option.begin(), option.end(), '_', '-');
       sequence.import.push_back("--" + option);
@@ -109,9 +106,7 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
             "import: unknown format " + import["format"].dump());
   } else if (has_path) {
     Require(entry["path"].is_string(), context, "\"path\" must be a string");
-    sequence.path = std::filesystem::path(entry["path"].get<std::string>());
-    if (sequence.path.is_relative()) sequence.path = folder / sequence.path;
-    sequence.path = sequence.path.lexically_normal();
+    sequence.path = FromManifest(entry["path"], folder);
     Require(!entry.contains("simulate"), context, "\"simulate\" only applies to a preset");
   } else {
     Require(entry["preset"].is_string(), context, "\"preset\" must be a string");
@@ -152,9 +147,7 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
   if (entry.contains("last_frame")) sequence.assignments.push_back(Assignment("run.last_frame", entry["last_frame"]));
   if (entry.contains("camera")) {
     Require(entry["camera"].is_string(), context, "\"camera\" must be the path of a camera JSON file");
-    std::filesystem::path file(entry["camera"].get<std::string>());
-    if (file.is_relative()) file = folder / file;
-    sequence.assignments.push_back("run.camera=" + file.lexically_normal().string());
+    sequence.assignments.push_back("run.camera=" + FromManifest(entry["camera"], folder).string());
   }
   if (entry.contains("rigid")) {
     Require(entry["rigid"].is_boolean(), context, "\"rigid\" must be true or false");

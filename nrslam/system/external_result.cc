@@ -59,15 +59,8 @@ void CheckFrame(double frame, int frame_count, const std::string& where) {
   }
 }
 
-bool CsvHasColumn(const fs::path& file, const std::string& name) {
-  std::ifstream in(file);
-  std::string header;
-  if (!std::getline(in, header)) return false;
-  const std::vector<std::string> columns = SplitCsvLine(header);
-  return std::find(columns.begin(), columns.end(), name) != columns.end();
-}
-
-FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count) {
+// `has_point_ids`: whether the file has its own point_id column (else ids number rows).
+FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_point_ids) {
   std::ifstream in(file);
   if (!in) throw Error("cannot read " + file.string());
   std::string line;
@@ -83,6 +76,7 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count) {
   const size_t frame_column = require("frame"), u_column = require("u"), v_column = require("v"),
                z_column = column.count("z_est") ? column.at("z_est") : require("z");
   const bool has_ids = column.count("point_id") > 0;
+  *has_point_ids = has_ids;
   const size_t id_column = has_ids ? column.at("point_id") : 0;
   const size_t needed = std::max({frame_column, u_column, v_column, z_column, id_column}) + 1;
   FrameEstimates estimates;
@@ -224,10 +218,11 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   const cv::Size size(info.camera.width(), info.camera.height());
   // Only a CSV with its own point_id column names points: depth images number pixels, and a
   // CSV without ids numbers rows. Recorded, so that nothing pairs such ids across runs.
-  const bool is_folder = fs::is_directory(result.estimates);
-  const bool ids_name_points = !is_folder && CsvHasColumn(result.estimates, "point_id");
-  const FrameEstimates estimates = is_folder ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
-                                       : ReadPointsCsv(result.estimates, reader.frame_count());
+  bool ids_name_points = false;
+  const FrameEstimates estimates =
+      fs::is_directory(result.estimates)
+          ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
+          : ReadPointsCsv(result.estimates, reader.frame_count(), &ids_name_points);
   const std::map<int, Rigid3> poses =
       result.trajectory.empty() ? std::map<int, Rigid3>{} : ReadTrajectory(result.trajectory, info.fps, reader.frame_count());
 
@@ -246,26 +241,25 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned(1);
   const std::vector<EstimatedPoint> none;
+  const std::string no_estimate = "no estimate of this frame in " + result.estimates.string();
   for (int frame = 0; frame < reader.frame_count(); ++frame) {
     const auto found = estimates.find(frame);
     const std::vector<EstimatedPoint>& points = found == estimates.end() ? none : found->second;
     const auto pose = poses.find(frame);
     const bool tracked = !points.empty() || pose != poses.end();
     FrameEvaluation frame_evaluation;
-    if (tracked) {
-      ++summary.frames_tracked;
-      if (summary.init_frame < 0) summary.init_frame = frame;
+    if (tracked && summary.init_frame < 0) {
+      summary.init_frame = frame;
       summary.maps = 1;  // one map: another system's figures are not split by its re-initialisations
-      summary.stop_frame = -1;
-      summary.stop_reason.clear();
+    }
+    summary.CountFrame(frame, tracked, no_estimate);
+    if (tracked) {
       std::vector<DepthPoint> depth_points;
       for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
       if (reader.has_depth() && !points.empty()) {
         frame_evaluation = EvaluateFrame(depth_points, reader.ReadDepthMm(frame), evaluation);
         if (frame_evaluation.evaluated) evaluations.push_back(frame_evaluation);
       }
-      std::vector<std::pair<cv::Point2f, double>> splats;
-      const double to_mm = frame_evaluation.evaluated ? frame_evaluation.scale : 1.0;
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));
@@ -276,11 +270,10 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
           points_csv << ",,";  // no pose: no world position
         }
         points_csv << ",tracked\n";
-        splats.emplace_back(cv::Point2f(static_cast<float>(point.pixel.x), static_cast<float>(point.pixel.y)),
-                            to_mm * point.depth);
       }
       const fs::path depth_file = out / "depth" / FrameFileName(frame);
-      if (!cv::imwrite(depth_file.string(), SplatDepth(splats, size, info.depth_unit_mm))) {
+      const double to_mm = frame_evaluation.evaluated ? frame_evaluation.scale : 1.0;
+      if (!cv::imwrite(depth_file.string(), SplatDepth(depth_points, to_mm, size, info.depth_unit_mm))) {
         throw Error("cannot write " + depth_file.string());
       }
       if (pose != poses.end()) {
@@ -290,10 +283,6 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
           aligned[0].groundtruth.push_back(reader.groundtruth()[static_cast<size_t>(frame)].world_from_camera.translation);
         }
       }
-    } else {
-      if (summary.init_frame >= 0) ++summary.frames_lost;
-      if (summary.stop_frame < 0) summary.stop_frame = frame;
-      summary.stop_reason = "no estimate of this frame in " + result.estimates.string();
     }
     const TrackingState state = tracked ? TrackingState::kTracking
                                 : summary.init_frame < 0 ? TrackingState::kNotInitialised

@@ -20,6 +20,21 @@ std::string RunSummary::Status() const {
   return stop_frame >= 0 ? "lost" : "ok";
 }
 
+void RunSummary::CountFrame(int frame, bool tracked, const std::string& note) {
+  if (tracked) {
+    ++frames_tracked;
+    stop_frame = -1;
+    stop_reason.clear();
+    return;
+  }
+  if (init_frame >= 0) ++frames_lost;
+  if (stop_frame < 0 || init_frame < 0) {
+    // Where the final untracked stretch began; before any map, the latest reason is the one that matters.
+    if (stop_frame < 0) stop_frame = frame;
+    stop_reason = note;
+  }
+}
+
 std::string DescribeSummary(const RunSummary& summary) {
   std::ostringstream text;
   text << "frames tracked " << summary.frames_tracked << "/" << summary.frames_total << " (init at " << summary.init_frame
@@ -72,12 +87,12 @@ std::ofstream OpenForWriting(const std::filesystem::path& path) {
   return file;
 }
 
-cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, const cv::Size& size, double unit_mm) {
+cv::Mat SplatDepth(const std::vector<DepthPoint>& points, double to_mm, const cv::Size& size, double unit_mm) {
   cv::Mat depth = cv::Mat::zeros(size, CV_16UC1);
-  for (const auto& [pixel, depth_mm] : points) {
-    const double value = std::round(depth_mm / unit_mm);
+  for (const DepthPoint& point : points) {
+    const double value = std::round(to_mm * point.depth / unit_mm);
     if (!(value > 0) || value > 65535) continue;
-    const int cx = cvRound(pixel.x), cy = cvRound(pixel.y);
+    const int cx = cvRound(point.pixel.x), cy = cvRound(point.pixel.y);
     for (int y = std::max(0, cy - 1); y <= std::min(size.height - 1, cy + 1); ++y) {
       for (int x = std::max(0, cx - 1); x <= std::min(size.width - 1, cx + 1); ++x) {
         depth.at<uint16_t>(y, x) = static_cast<uint16_t>(value);

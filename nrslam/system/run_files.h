@@ -44,6 +44,9 @@ struct RunSummary {
   std::string stop_reason;
   // "ok", "lost" (the run ends without tracking) or "not_initialised".
   std::string Status() const;
+  // Counts one processed frame, tracked or not (`note`: why not): frames_tracked, frames_lost
+  // and where the final untracked stretch began. Set init_frame first on the frame a map starts.
+  void CountFrame(int frame, bool tracked, const std::string& note);
 };
 
 // How a run that ends without tracking stopped: "lost from frame 12: only 7 points left after
@@ -71,8 +74,9 @@ std::string DescribeSummary(const RunSummary& summary);
 // A text file for the run folder, numbers at 9 significant digits; throws Error if it cannot be opened.
 std::ofstream OpenForWriting(const std::filesystem::path& path);
 
-// Estimated depth image: each point a 3x3 splat of its depth (mm), 16-bit in `unit_mm`.
-cv::Mat SplatDepth(const std::vector<std::pair<cv::Point2f, double>>& points, const cv::Size& size, double unit_mm);
+// Estimated depth image: each point a 3x3 splat of its depth times `to_mm` (the frame's scale
+// when it was evaluated), 16-bit in `unit_mm`.
+cv::Mat SplatDepth(const std::vector<DepthPoint>& points, double to_mm, const cv::Size& size, double unit_mm);
 
 // summary.json: the summary's figures under the key names of design §5, plus `provenance`'s
 // keys (how the run was made: init, mapping, mode).

@@ -200,7 +200,6 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     std::vector<DepthPoint> depth_points;
     const bool tracked = result.state == TrackingState::kTracking;
     if (tracked) {
-      ++summary.frames_tracked;
       trajectory.push_back({frame / reader.info().fps, result.cam_from_world.Inverse()});
       if (reader.has_groundtruth()) {
         aligned_maps.resize(static_cast<size_t>(maps));
@@ -220,22 +219,11 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         if (evaluation.evaluated) evaluations.push_back(evaluation);
       }
-      std::vector<std::pair<cv::Point2f, double>> splats;
-      const double to_mm = evaluation.evaluated ? evaluation.scale : 1.0;
-      for (size_t i = 0; i < result.points.size(); ++i) splats.emplace_back(result.points[i].pixel, to_mm * depth_points[i].depth);
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
-      io.Write(out / "depth" / FrameFileName(frame), SplatDepth(splats, size, reader.info().depth_unit_mm));
-    } else if (summary.init_frame >= 0) {
-      ++summary.frames_lost;
+      io.Write(out / "depth" / FrameFileName(frame),
+               SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
     }
-    if (tracked) {
-      summary.stop_frame = -1;
-      summary.stop_reason.clear();
-    } else if (summary.stop_frame < 0 || summary.init_frame < 0) {
-      // Where the final untracked stretch began; before any map, the latest reason is the one that matters.
-      if (summary.stop_frame < 0) summary.stop_frame = frame;
-      summary.stop_reason = result.note;
-    }
+    summary.CountFrame(frame, tracked, result.note);
     metrics_csv << frame << ',' << ToString(result.state) << ',' << maps << ',' << result.points.size() << ','
                 << result.klt_tracked << ',' << result.candidates.size() << ',' << result.outliers << ','
                 << result.propagated << ',' << result.reassociated << ',' << mapping.rigid_candidates << ','
