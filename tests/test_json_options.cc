@@ -30,6 +30,12 @@ TEST(JsonOptions, UnknownOptionIsAnErrorThatListsTheKnownOnes) {
 TEST(JsonOptions, BadValuesAndInvalidResultsAreRejected) {
   EXPECT_THROW(WithAssignments(SimOptions{}, {"frames=many"}), Error);
   EXPECT_THROW(WithAssignments(SimOptions{}, {"frames"}), Error);
+  // No Check() involved: JSON cannot hold these, so config.json would record null.
+  for (const char* not_finite : {"inf", "-inf", "nan", "infinity"}) {
+    Json config = {{"k", 1.1}};
+    EXPECT_THROW(ApplyAssignment(config, std::string("k=") + not_finite), Error) << not_finite;
+    EXPECT_EQ(config["k"], 1.1);
+  }
   EXPECT_THROW(WithAssignments(SimOptions{}, {"deformation=3"}), Error);          // a group
   EXPECT_THROW(WithAssignments(SimOptions{}, {"camera.model=orthographic"}), Error);  // fails Check()
   EXPECT_THROW(OptionsFromJson<SimOptions>(Json{{"sceen", "colon"}}, "test"), Error);

@@ -1,5 +1,6 @@
 #include "nrslam/util/json_options.h"
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -57,7 +58,8 @@ Json ParseLike(const Json& existing, const std::string& text, const std::string&
       }
       case Json::value_t::number_float: {
         const double value = std::stod(text, &used);
-        if (used != text.size()) break;
+        // JSON has no inf or NaN: config.json would record null and the run could not be repeated.
+        if (used != text.size() || !std::isfinite(value)) break;
         return value;
       }
       case Json::value_t::boolean:
@@ -79,7 +81,8 @@ Json ParseLike(const Json& existing, const std::string& text, const std::string&
   }
   std::ostringstream message;
   message << "option " << path << ": cannot use '" << text << "' (expected "
-          << existing.type_name() << ", like " << existing.dump() << ")";
+          << (existing.is_number_float() ? "a finite number" : existing.type_name()) << ", like "
+          << existing.dump() << ")";
   throw Error(message.str());
 }
 
