@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "nrslam/batch/evaluation_plan.h"
@@ -185,6 +186,22 @@ TEST(Results, RunsWithoutGroundTruthShowNoRmse) {
   Json old = ToJson({simulated});
   old["results"][0].erase("frames_evaluated");
   EXPECT_EQ(ResultsFromJson(old)[0].frames_evaluated, 42);
+}
+
+// A run that never initialised tracked nothing: no init frame and no RMSE, not "no GT".
+TEST(Results, NeverInitialisedRunShowsDashesNotMissingGroundTruth) {
+  RunResult waiting;
+  waiting.sequence = "uniform";
+  waiting.status = "not_initialised";
+  waiting.init_frame = -1;
+  waiting.frames_total = 30;
+  waiting.fps = 200;
+  std::stringstream table;
+  PrintResults({waiting}, table);
+  const std::string row = table.str().substr(table.str().find("uniform"));
+  EXPECT_EQ(row.find("no GT"), std::string::npos) << table.str();
+  EXPECT_EQ(row.find("-1"), std::string::npos) << table.str();
+  EXPECT_TRUE(std::regex_search(row, std::regex(R"(not_initialised +- +0/30 +- +- +- +- +200\.0)"))) << table.str();
 }
 
 TEST(Results, WhereAndWhyARunStoppedIsShownAndKept) {

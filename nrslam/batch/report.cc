@@ -227,7 +227,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
       html << "<td class=\"failed\">FAILED</td><td colspan=\"7\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
       continue;
     }
-    html << "<td>" << r.status << "</td><td>" << r.init_frame << "</td><td>" << r.frames_tracked << "/"
+    html << "<td>" << r.status << "</td><td>" << InitFrameCell(r) << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
          << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FlatRmseCell(r) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";

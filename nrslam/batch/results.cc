@@ -104,11 +104,16 @@ std::string StopText(const RunResult& result) {
 }
 
 std::string RmseCell(const RunResult& result, double rmse_mm) {
-  return result.evaluated() ? FormatFixed(rmse_mm, 3) : "no GT";
+  if (result.evaluated()) return FormatFixed(rmse_mm, 3);
+  return result.frames_tracked > 0 ? "no GT" : "-";  // with no frame tracked there was nothing to score
 }
 
 std::string FlatRmseCell(const RunResult& result) {
   return result.rmse_flat_mm >= 0 ? RmseCell(result, result.rmse_flat_mm) : "-";
+}
+
+std::string InitFrameCell(const RunResult& result) {
+  return result.init_frame >= 0 ? std::to_string(result.init_frame) : "-";
 }
 
 std::string AteCell(double ate_mm) { return ate_mm >= 0 ? FormatFixed(ate_mm, 3) : "-"; }
@@ -208,7 +213,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     if (r.status == "failed") {
       for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
     } else {
-      row.insert(row.end(), {r.status, std::to_string(r.init_frame),
+      row.insert(row.end(), {r.status, InitFrameCell(r),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
                              RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), FlatRmseCell(r), AteCell(r.ate_mm),
                              r.fps > 0 ? FormatFixed(r.fps, 1) : "-"});  // an external result has none

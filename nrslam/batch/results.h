@@ -52,10 +52,13 @@ struct RmseChangeCounts {
 // Where and why a run that ends without tracking stopped: "lost from frame 12: only 7 points
 // left after outlier rejection" or "never initialised: …"; "" when it ends tracking or failed.
 std::string StopText(const RunResult& result);
-// An RMSE figure of `result` as a table shows it: "no GT" when nothing was evaluated.
+// An RMSE figure of `result` as a table shows it: "no GT" when frames were tracked but none had
+// ground truth, "-" when no frame was tracked.
 std::string RmseCell(const RunResult& result, double rmse_mm);
 // A run's flat-map RMSE as a table shows it: "-" for results written before it was recorded.
 std::string FlatRmseCell(const RunResult& result);
+// The frame a run initialised at, "-" when it never did.
+std::string InitFrameCell(const RunResult& result);
 // A trajectory error (a run's or a mean) as a table shows it: "-" when there was none (negative).
 std::string AteCell(double ate_mm);
 

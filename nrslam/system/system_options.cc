@@ -1,6 +1,7 @@
 #include "nrslam/system/system_options.h"
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "nrslam/util/json_options.h"
@@ -9,7 +10,10 @@ namespace nrslam {
 
 void RunOptions::Check() const {
   CheckOption(init == "depth" || init == "monocular", "run", "init must be depth or monocular, got '" + init + "'");
-  CheckOption(first_frame >= 0 && (last_frame < 0 || last_frame > first_frame), "run", "bad frame range");
+  CheckOption(first_frame >= 0, "run", "first_frame must be >= 0, got " + std::to_string(first_frame));
+  CheckOption(last_frame < 0 || last_frame > first_frame, "run",
+              "the frame range [first_frame, last_frame) = [" + std::to_string(first_frame) + ", " +
+                  std::to_string(last_frame) + ") is empty (last_frame -1 = to the end)");
 }
 
 SystemOptions SystemOptionsFromFile(const std::filesystem::path& file) {
