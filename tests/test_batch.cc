@@ -665,6 +665,34 @@ std::filesystem::path StandInRunner(const std::filesystem::path& folder, const s
   return runner;
 }
 
+// Out-of-range arguments are refused with a message naming them, not replaced by a default or
+// wrapped around: each command exits non-zero, writes nothing, and says what was wrong.
+TEST(Tools, OutOfRangeArgumentsAreRefused) {
+  const auto folder = UniqueTempFolder("tool_arguments");
+  std::filesystem::create_directories(folder);
+  const std::string log = (folder / "log.txt").string();
+  const auto refused = [&](const std::string& command, const std::string& message) {
+    const int status = std::system((command + " > " + log + " 2>&1").c_str());
+    std::ifstream stream(log);
+    const std::string output((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    EXPECT_NE(status, 0) << command;
+    EXPECT_NE(output.find(message), std::string::npos) << command << "\n" << output;
+  };
+  const std::string simulate = kPrograms.simulate.string() + " --preset sim-0 --quiet --out " + (folder / "seq").string();
+  refused(simulate + " --frames 0", "frames must be in [1, 100000]");
+  refused(simulate + " --frames -3", "frames must be in [1, 100000]");
+  refused(simulate + " --width 0", "image size must be");
+  refused(simulate + " --seed -1", "--seed must be >= 0, got -1");
+  EXPECT_FALSE(std::filesystem::exists(folder / "seq"));
+  const std::filesystem::path manifest =
+      WriteFile(folder / "m.json", R"({"sequences": [{"name": "a", "preset": "sim-0"}]})");
+  const std::string eval = kPrograms.eval.string() + " " + manifest.string() + " --out " + (folder / "out").string();
+  refused(eval + " --jobs 0", "--jobs: Value 0 not in range 1 to 256");
+  refused(eval + " --sweep deformation.k=1,inf", "cannot use 'inf' (expected a finite number");
+  EXPECT_FALSE(std::filesystem::exists(folder / "out" / "results.json"));
+  std::filesystem::remove_all(folder);
+}
+
 TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   const auto folder = UniqueTempFolder("batch_crash");
   EvaluationPlan plan;

@@ -94,11 +94,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--cache", cache, "where presets are rendered and datasets imported, shared between evaluations")
       ->capture_default_str();
-  app.add_option("--jobs,-j", jobs, "processes at once")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--jobs,-j", jobs, "processes at once")->capture_default_str()->check(CLI::Range(1, 256));
   app.add_option("--timeout", run_timeout, "seconds (wall clock) a run may take before it is killed and recorded as "
                                            "failed, so a run that hangs cannot stall the batch; 0: no limit")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 1e7));
   app.add_option("--config", config_path, "JSON options for every sequence (a run's config.json or an options "
                                           "object): those that differ from the defaults, before --set");
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");

@@ -24,17 +24,19 @@ int main(int argc, char** argv) {
   CLI::App app{"Render simulated endoscopy sequences with exact depth ground truth."};
   std::string preset = "sim-0", out, config_path, camera_model;
   bool suite = false, stereo = false, print_options = false, quiet = false;
-  int frames = -1, width = -1, height = -1;
-  int64_t seed = -1;
+  int frames = 0, width = 0, height = 0;
+  int64_t seed = 0;
   std::vector<std::string> assignments;
   app.add_option("--preset", preset, "sim-0 … sim-6, lap-lobes")->capture_default_str();
   app.add_flag("--suite", suite, "render every preset into OUT/<preset> and print a summary table");
   app.add_option("--out", out, "output sequence folder (with --suite: parent folder)");
   app.add_option("--config", config_path, "JSON file of simulator options applied over the preset");
-  app.add_option("--frames", frames, "number of frames");
-  app.add_option("--width", width, "image width, px");
-  app.add_option("--height", height, "image height, px");
-  app.add_option("--seed", seed, "random seed (same seed and options = identical files)");
+  // Given values go to the options as they are, so that their Check() rejects a bad one.
+  const CLI::Option* frames_given = app.add_option("--frames", frames, "number of frames");
+  const CLI::Option* width_given = app.add_option("--width", width, "image width, px");
+  const CLI::Option* height_given = app.add_option("--height", height, "image height, px");
+  const CLI::Option* seed_given =
+      app.add_option("--seed", seed, "random seed (same seed and options = identical files)");
   app.add_option("--camera", camera_model, "pinhole or fisheye")->check(CLI::IsMember({"pinhole", "fisheye"}));
   app.add_flag("--stereo", stereo, "also render a rectified right camera");
   app.add_option("--set", assignments, "set any option, e.g. --set deformation.amplitude_mm=5 (see --print-options)");
@@ -50,10 +52,13 @@ int main(int argc, char** argv) {
         if (!file) throw nrslam::Error("cannot read " + config_path);
         options = nrslam::OptionsFromJson(nrslam::Json::parse(file), config_path, options);
       }
-      if (frames > 0) options.frames = frames;
-      if (width > 0) options.camera.width = width;
-      if (height > 0) options.camera.height = height;
-      if (seed >= 0) options.seed = static_cast<uint64_t>(seed);
+      if (frames_given->count()) options.frames = frames;
+      if (width_given->count()) options.camera.width = width;
+      if (height_given->count()) options.camera.height = height;
+      if (seed_given->count()) {
+        if (seed < 0) throw nrslam::Error("--seed must be >= 0, got " + std::to_string(seed));
+        options.seed = static_cast<uint64_t>(seed);
+      }
       if (!camera_model.empty()) options.camera.model = camera_model;
       if (stereo) options.camera.stereo = true;
       return nrslam::WithAssignments(options, assignments);
