@@ -41,6 +41,24 @@ TEST(JsonOptions, BadValuesAndInvalidResultsAreRejected) {
   EXPECT_THROW(OptionsFromJson<SimOptions>(Json{{"sceen", "colon"}}, "test"), Error);
 }
 
+// A value of the wrong kind in an options file is named with what it got, rather than
+// nlohmann's bare type error, and a fraction is not truncated into a whole-number option.
+TEST(JsonOptions, ValuesOfTheWrongKindAreNamed) {
+  const Json given = {{"frames", 2.5}, {"camera", {{"model", 3}, {"fov_deg", 80}}}, {"deformation", "strong"}};
+  try {
+    OptionsFromJson<SimOptions>(given, "options.json");
+    FAIL() << "wrongly typed values were accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("options.json: "), std::string::npos) << what;
+    EXPECT_NE(what.find("frames must be a whole number, got 2.5"), std::string::npos) << what;
+    EXPECT_NE(what.find("camera.model must be a string, got 3"), std::string::npos) << what;
+    EXPECT_NE(what.find("deformation is a group of options, got \"strong\""), std::string::npos) << what;
+    EXPECT_EQ(what.find("fov_deg"), std::string::npos) << what;  // a whole number is a number
+  }
+  EXPECT_DOUBLE_EQ(OptionsFromJson<SimOptions>(Json{{"camera", {{"fov_deg", 80}}}}, "test").camera.fov_deg, 80.0);
+}
+
 TEST(JsonOptions, RoundTripKeepsEveryField) {
   SimOptions options = SimPreset("sim-5");
   options.colon.fold_width_mm = 1.7;

@@ -40,6 +40,41 @@ void CollectUnknown(const Json& given, const Json& reference, const std::string&
   }
 }
 
+// What a leaf of the defaults accepts, as an error message says it ("" for any value).
+std::string ExpectedKind(const Json& reference) {
+  if (reference.is_boolean()) return "true or false";
+  if (reference.is_number_integer()) return "a whole number";
+  if (reference.is_number()) return "a number";
+  if (reference.is_string()) return "a string";
+  if (reference.is_array()) return "a list";
+  return "";
+}
+
+bool HasKind(const Json& value, const Json& reference) {
+  if (reference.is_boolean()) return value.is_boolean();
+  if (reference.is_number_integer()) return value.is_number_integer();
+  if (reference.is_number()) return value.is_number();
+  if (reference.is_string()) return value.is_string();
+  if (reference.is_array()) return value.is_array();
+  return true;
+}
+
+void CollectMistyped(const Json& given, const Json& reference, const std::string& prefix,
+                     std::vector<std::string>* mistyped) {
+  if (!given.is_object() || !reference.is_object()) return;
+  for (auto it = given.begin(); it != given.end(); ++it) {
+    if (!reference.contains(it.key())) continue;
+    const std::string path = prefix.empty() ? it.key() : prefix + "." + it.key();
+    const Json& expected = reference.at(it.key());
+    if (expected.is_object()) {
+      if (!it.value().is_object()) mistyped->push_back(path + " is a group of options, got " + it.value().dump());
+      CollectMistyped(it.value(), expected, path, mistyped);
+    } else if (!HasKind(it.value(), expected)) {
+      mistyped->push_back(path + " must be " + ExpectedKind(expected) + ", got " + it.value().dump());
+    }
+  }
+}
+
 std::string Join(const std::vector<std::string>& items, const std::string& separator) {
   std::string out;
   for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
@@ -112,6 +147,12 @@ void RejectUnknownKeys(const Json& given, const Json& reference, const std::stri
     throw Error(context + ": unknown option(s) " + Join(unknown, ", ") +
                 "; known options: " + Join(LeafPaths(reference), ", "));
   }
+}
+
+void RejectMistypedValues(const Json& given, const Json& reference, const std::string& context) {
+  std::vector<std::string> mistyped;
+  CollectMistyped(given, reference, "", &mistyped);
+  if (!mistyped.empty()) throw Error(context + ": " + Join(mistyped, "; "));
 }
 
 void ApplyAssignment(Json& config, const std::string& assignment) {
