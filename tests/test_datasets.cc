@@ -194,6 +194,12 @@ TEST(DatasetImport, PlainImageFolderAndVideoWithACalibration) {
   options.input = in / "clip.avi";
   ImportDataset(options, out);
   EXPECT_EQ(SequenceReader(out).frame_count(), 5);
+  // Another sequence's sequence.json serves as the calibration: its "camera" is read.
+  fs::copy(out / "sequence.json", in / "sequence.json");
+  options.calibration = in / "sequence.json";
+  fs::remove_all(out);
+  ImportDataset(options, out);
+  EXPECT_DOUBLE_EQ(SequenceReader(out).info().camera.fy(), 51.0);
   // A calibration for another image size is caught.
   std::ofstream(in / "wrong.json") << R"({"model": "pinhole", "width": 640, "height": 480, "fx": 500, "fy": 500, "cx": 319.5, "cy": 239.5})";
   options.calibration = in / "wrong.json";

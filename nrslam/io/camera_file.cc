@@ -7,7 +7,9 @@ namespace nrslam {
 Camera ReadCameraFile(const std::filesystem::path& file) {
   const Json json = ReadJsonFile(file);
   try {
-    Camera camera = json.get<Camera>();
+    // A sequence.json holds the camera under "camera"; taking it saves users cutting it out.
+    const bool sequence_file = json.is_object() && json.contains("camera") && json.at("camera").is_object();
+    Camera camera = (sequence_file ? json.at("camera") : json).get<Camera>();
     camera.Check();
     return camera;
   } catch (const std::exception& e) {

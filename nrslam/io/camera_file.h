@@ -1,5 +1,6 @@
 // io: a camera calibration on its own, as a JSON file holding what sequence.json's "camera"
-// holds (model, width, height, fx, fy, cx, cy, and k for kannala_brandt).
+// holds (model, width, height, fx, fy, cx, cy, and k for kannala_brandt), or a whole
+// sequence.json, whose "camera" is then read.
 #pragma once
 
 #include <filesystem>
