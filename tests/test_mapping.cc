@@ -128,6 +128,44 @@ TEST(DeformableBundleAdjustment, RestoresEachKeyframesShapeAndKeepsTheOldestPose
   EXPECT_LT(first_error, 0.01);
 }
 
+// The ablation switches drop exactly their own terms: one elastic block per pair and keyframe,
+// one viscous block per pair between consecutive keyframes. Without the springs nothing
+// restores the shapes' edge lengths: the reprojections still fit, but the strain stays.
+TEST(DeformableBundleAdjustment, AblationsDropTheirOwnTerms) {
+  const auto run = [](bool elastic, bool viscous, double* strain_after) {
+    DbaScene scene;
+    scene.options.elastic = elastic;
+    scene.options.viscous = viscous;
+    const std::vector<std::vector<DbaPair>> regularisers = WindowRegularisers(scene.graph, scene.Window());
+    const DbaReport report =
+        DeformableBundleAdjustment(scene.camera, scene.options, regularisers, 1.0, 30, false, scene.Window());
+    *strain_after = scene.MeanStrain();
+    EXPECT_LT(scene.MaxReprojectionPx(), 0.5);
+    return report.residual_blocks;
+  };
+  double strain_both = 0, strain_viscous = 0, strain_elastic = 0, strain_none = 0;
+  const int both = run(true, true, &strain_both);
+  const int viscous_only = run(false, true, &strain_viscous);
+  const int elastic_only = run(true, false, &strain_elastic);
+  const int neither = run(false, false, &strain_none);
+  DbaScene scene;
+  const std::vector<std::vector<DbaPair>> regularisers = WindowRegularisers(scene.graph, scene.Window());
+  int pairs = 0, links = 0;
+  for (const auto& keyframe_pairs : regularisers) {
+    for (const DbaPair& pair : keyframe_pairs) {
+      ++pairs;
+      links += pair.next_i >= 0;
+    }
+  }
+  ASSERT_GT(links, 0);
+  EXPECT_EQ(neither, 4 * 60);  // the reprojections alone
+  EXPECT_EQ(both - viscous_only, pairs);
+  EXPECT_EQ(both - elastic_only, links);
+  EXPECT_EQ(both, neither + pairs + links);
+  EXPECT_LT(strain_both, 0.5 * strain_viscous);
+  EXPECT_LT(strain_elastic, 0.5 * strain_none);
+}
+
 TEST(DeformableBundleAdjustment, RigidModeSharesOnePositionPerPoint) {
   DbaScene scene;
   const DbaReport report = DeformableBundleAdjustment(scene.camera, scene.options, {}, 1.0, 30, true, scene.Window());

@@ -342,6 +342,20 @@ TEST_F(RunSequenceTest, MotionSeedStartsTheSolvesElsewhereAndStillTracks) {
   EXPECT_NE(seeded.rmse_mm, summary_->rmse_mm);
 }
 
+// Each regulariser can be switched off for an ablation, and tracking then solves another problem.
+TEST_F(RunSequenceTest, RegularisersCanBeAblatedOneByOne) {
+  for (const bool elastic : {false, true}) {
+    SystemOptions options = TrackingExperiment();
+    options.deformation.elastic = elastic;
+    options.deformation.viscous = !elastic;
+    const std::string name = elastic ? "elastic_only" : "viscous_only";
+    const RunSummary ablated = RunSequence(*base_ / "sequence", options, *base_ / name);
+    EXPECT_GT(ablated.frames_tracked, 0) << name;
+    EXPECT_NE(ablated.rmse_mm, summary_->rmse_mm) << name;
+    EXPECT_EQ(ReadJsonFile(*base_ / name / "config.json")["options"]["deformation"]["elastic"], elastic) << name;
+  }
+}
+
 TEST(MotionSeed, TheCommonMotionIsRemovedAndTheRestKept) {
   const std::vector<Eigen::Vector3d> relative =
       WithoutCommonMotion({{1.0, 2.0, 3.0}, {3.0, 2.0, 1.0}, {2.0, 5.0, 2.0}});

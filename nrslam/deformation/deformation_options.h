@@ -28,6 +28,11 @@ struct DeformationModelOptions {
   double huber_deformation = 0.7642; // Huber δ of the regularisers (√0.584, χ² 3-DoF 10 %)
   double huber_reprojection = 2.4474;  // Huber δ of reprojection residuals (√5.99, χ² 2-DoF 5 %)
   double reprojection_sigma_px = 0.5;  // σ of a KLT match, px
+  // Ablations: false drops that regulariser from tracking and the DBA (the graph, its pruning
+  // and deformable triangulation's neighbour flow are unchanged). With neither, a point's
+  // motion along its viewing ray is held by nothing but the solver's damping.
+  bool elastic = true;
+  bool viscous = true;
 
   bool paper_weighting() const { return weighting == "paper"; }
   void Check() const;
@@ -36,6 +41,6 @@ struct DeformationModelOptions {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(DeformationModelOptions, k, weighting, sigma_factor, max_degree_D,
                                                 stretch_threshold, min_edge_weight, min_good_edges, elastic_sigma,
                                                 viscous_sigma_factor, huber_deformation, huber_reprojection,
-                                                reprojection_sigma_px)
+                                                reprojection_sigma_px, elastic, viscous)
 
 }  // namespace nrslam

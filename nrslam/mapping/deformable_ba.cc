@@ -92,11 +92,13 @@ DbaReport DeformableBundleAdjustment(const Camera& camera, const DeformationMode
     for (size_t k = 0; k < window.size(); ++k) {
       std::vector<Eigen::Vector3d>& positions = window[k]->positions;
       for (const DbaPair& pair : regularisers[k]) {
-        problem.AddResidualBlock(ElasticCost::Create(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), pair.rest_length,
-                                                     ElasticMultiplier(options, pair.rest_length)),
-                                 nullptr, positions[pair.i].data(), positions[pair.j].data());
-        ++report.residual_blocks;
-        if (pair.next_i >= 0) {
+        if (options.elastic) {
+          problem.AddResidualBlock(ElasticCost::Create(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                       pair.rest_length, ElasticMultiplier(options, pair.rest_length)),
+                                   nullptr, positions[pair.i].data(), positions[pair.j].data());
+          ++report.residual_blocks;
+        }
+        if (options.viscous && pair.next_i >= 0) {
           std::vector<Eigen::Vector3d>& next = window[k + 1]->positions;
           problem.AddResidualBlock(ViscousKeyframeCost::Create(ViscousMultiplier(options, pair.weight_b, map_scale)),
                                    new ceres::HuberLoss(options.huber_deformation), positions[pair.i].data(),

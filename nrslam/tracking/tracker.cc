@@ -402,9 +402,9 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
       const Pair& pair = pairs[p];
       double* delta_i = (*displacements)[pair.i].data();
       double* delta_j = (*displacements)[pair.j].data();
-      problem.AddResidualBlock(elastic_costs[p].get(), &deformation_loss, delta_i, delta_j);
+      if (deformation_.elastic) problem.AddResidualBlock(elastic_costs[p].get(), &deformation_loss, delta_i, delta_j);
       // An outlier's motion is not evidence for its neighbours': its viscous terms go too.
-      if ((*inliers)[pair.i] && (*inliers)[pair.j] && viscous_on[p]) {
+      if (deformation_.viscous && (*inliers)[pair.i] && (*inliers)[pair.j] && viscous_on[p]) {
         problem.AddResidualBlock(viscous_costs[p].get(), &deformation_loss, delta_i, delta_j);
       }
     }
