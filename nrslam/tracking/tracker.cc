@@ -365,9 +365,11 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
                                                                    deformation_.reprojection_sigma_px));
   }
   for (const Pair& pair : pairs) {
-    elastic_costs.emplace_back(ElasticCost::Create(points[pair.i], points[pair.j], pair.rest_length,
-                                                   ElasticMultiplier(deformation_, pair.rest_length)));
-    viscous_costs.emplace_back(ViscousCost::Create(pair.viscous_multiplier));
+    if (deformation_.elastic) {
+      elastic_costs.emplace_back(ElasticCost::Create(points[pair.i], points[pair.j], pair.rest_length,
+                                                     ElasticMultiplier(deformation_, pair.rest_length)));
+    }
+    if (deformation_.viscous) viscous_costs.emplace_back(ViscousCost::Create(pair.viscous_multiplier));
   }
   std::unique_ptr<ceres::CostFunction> displacement_prior;
   if (options_.displacement_prior_sigma > 0) {

@@ -40,23 +40,22 @@ void CollectUnknown(const Json& given, const Json& reference, const std::string&
   }
 }
 
-// What a leaf of the defaults accepts, as an error message says it ("" for any value).
-std::string ExpectedKind(const Json& reference) {
-  if (reference.is_boolean()) return "true or false";
-  if (reference.is_number_integer()) return "a whole number";
-  if (reference.is_number()) return "a number";
-  if (reference.is_string()) return "a string";
-  if (reference.is_array()) return "a list";
+// What an options file must give for a key whose default is `value`, as an error message says
+// it; "" for a default of no particular kind (null).
+std::string KindOf(const Json& value) {
+  if (value.is_boolean()) return "true or false";
+  if (value.is_number_integer()) return "a whole number";
+  if (value.is_number()) return "a number";
+  if (value.is_string()) return "a string";
+  if (value.is_array()) return "a list";
+  if (value.is_object()) return "a group of options";
   return "";
 }
 
-bool HasKind(const Json& value, const Json& reference) {
-  if (reference.is_boolean()) return value.is_boolean();
-  if (reference.is_number_integer()) return value.is_number_integer();
-  if (reference.is_number()) return value.is_number();
-  if (reference.is_string()) return value.is_string();
-  if (reference.is_array()) return value.is_array();
-  return true;
+// A whole number is a number too; the reverse would truncate.
+bool Fits(const Json& value, const Json& reference) {
+  const std::string expected = KindOf(reference);
+  return expected.empty() || KindOf(value) == expected || (expected == "a number" && value.is_number());
 }
 
 void CollectMistyped(const Json& given, const Json& reference, const std::string& prefix,
@@ -66,12 +65,11 @@ void CollectMistyped(const Json& given, const Json& reference, const std::string
     if (!reference.contains(it.key())) continue;
     const std::string path = prefix.empty() ? it.key() : prefix + "." + it.key();
     const Json& expected = reference.at(it.key());
-    if (expected.is_object()) {
-      if (!it.value().is_object()) mistyped->push_back(path + " is a group of options, got " + it.value().dump());
-      CollectMistyped(it.value(), expected, path, mistyped);
-    } else if (!HasKind(it.value(), expected)) {
-      mistyped->push_back(path + " must be " + ExpectedKind(expected) + ", got " + it.value().dump());
+    if (!Fits(it.value(), expected)) {
+      mistyped->push_back(path + (expected.is_object() ? " is " : " must be ") + KindOf(expected) + ", got " +
+                          it.value().dump());
     }
+    CollectMistyped(it.value(), expected, path, mistyped);
   }
 }
 
