@@ -169,7 +169,7 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
 namespace {
 
 const std::filesystem::path& ProgramOf(const RunJob& run, const Programs& programs) {
-  return run.external.is_null() ? programs.run : programs.eval;
+  return run.is_external() ? programs.eval : programs.run;
 }
 
 std::vector<std::string> PrepareCommand(const PrepareJob& prepare, const Programs& programs) {
@@ -205,7 +205,7 @@ bool RunIsFinished(const RunJob& run) {
     const Json config = ReadJsonFile(run.run_folder / "config.json");
     const bool same_sequence =
         config.at("sequence").get<std::string>() == std::filesystem::absolute(run.sequence_folder).string();
-    if (!run.external.is_null()) return config.value("external", Json()) == run.external && same_sequence;
+    if (run.is_external()) return config.value("external", Json()) == run.external && same_sequence;
     // Parsed back through the options struct, so that a config written before an option
     // existed compares as that option's default.
     const Json options = OptionsFromJson<SystemOptions>(config.at("options"), "config.json");

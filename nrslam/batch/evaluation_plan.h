@@ -40,6 +40,7 @@ struct RunJob {
   // config.json records (ToJson of system/external_result.h); null for a run of ours.
   Json external;
   int prepare = -1;                          // index into EvaluationPlan::prepares, or -1
+  bool is_external() const { return !external.is_null(); }
 };
 
 struct EvaluationPlan {

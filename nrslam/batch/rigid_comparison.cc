@@ -20,8 +20,6 @@ std::string BaselineKey(const RunJob& run) {
 
 bool IsRigid(const RunJob& run) { return run.options.at("tracking").at("rigid").get<bool>(); }
 
-bool IsExternal(const RunJob& run) { return !run.external.is_null(); }
-
 std::string Ratio(double rigid_mm, double deformable_mm) {
   return deformable_mm > 0 ? FormatFixed(rigid_mm / deformable_mm, 2) : "-";
 }
@@ -57,13 +55,13 @@ std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const 
   if (results.size() != plan.runs.size()) throw Error("rigid comparison: results do not match the plan's runs");
   std::map<std::string, size_t> rigid_runs;
   for (size_t i = 0; i < plan.runs.size(); ++i) {
-    if (!IsExternal(plan.runs[i]) && IsRigid(plan.runs[i]) && results[i].status != "failed" && results[i].evaluated()) {
+    if (!plan.runs[i].is_external() && IsRigid(plan.runs[i]) && results[i].status != "failed" && results[i].evaluated()) {
       rigid_runs.emplace(BaselineKey(plan.runs[i]), i);  // the first one of a key stays
     }
   }
   std::vector<RigidComparison> comparisons;
   for (size_t i = 0; i < plan.runs.size(); ++i) {
-    if (IsExternal(plan.runs[i]) || IsRigid(plan.runs[i]) || results[i].status == "failed" || !results[i].evaluated()) continue;
+    if (plan.runs[i].is_external() || IsRigid(plan.runs[i]) || results[i].status == "failed" || !results[i].evaluated()) continue;
     const auto rigid = rigid_runs.find(BaselineKey(plan.runs[i]));
     if (rigid == rigid_runs.end()) continue;
     RigidComparison comparison{results[i], results[rigid->second], {}};

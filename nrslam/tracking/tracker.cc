@@ -193,8 +193,7 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
   frames_since_keyframe_ = 0;
 }
 
-void Tracker::RetireDroppedPoints(std::vector<PointId> in_use_elsewhere) {
-  std::vector<PointId>& in_use = in_use_elsewhere;
+void Tracker::RetireDroppedPoints(std::vector<PointId> in_use) {
   for (const PointTrack& track : tracks_) {
     if (track.active && track.id != kNoPoint) in_use.push_back(track.id);
   }

@@ -96,9 +96,9 @@ class Tracker {
   // Mapping's refined estimate of the current camera (e.g. after DBA).
   void SetPose(const Rigid3& cam_from_world) { cam_from_world_ = cam_from_world; }
   // Retires in the graph every map point that neither this tracker (tracked or lost and
-  // looked for) nor the caller (`in_use_elsewhere`, e.g. the DBA window) will read again:
-  // none of them can come back, so their edges among themselves can go (DeformationGraph::Retire).
-  void RetireDroppedPoints(std::vector<PointId> in_use_elsewhere);
+  // looked for) nor the caller (`in_use`, e.g. the DBA window) will read again: none of them
+  // can come back, so their edges among themselves can go (DeformationGraph::Retire).
+  void RetireDroppedPoints(std::vector<PointId> in_use);
 
   TrackingState state() const { return state_; }
   const Rigid3& pose() const { return cam_from_world_; }

@@ -27,19 +27,6 @@ void CollectChanged(const Json& base, const Json& changed, const std::string& pr
   }
 }
 
-void CollectUnknown(const Json& given, const Json& reference, const std::string& prefix,
-                    std::vector<std::string>* unknown) {
-  if (!given.is_object() || !reference.is_object()) return;
-  for (auto it = given.begin(); it != given.end(); ++it) {
-    const std::string path = prefix.empty() ? it.key() : prefix + "." + it.key();
-    if (!reference.contains(it.key())) {
-      unknown->push_back(path);
-    } else {
-      CollectUnknown(it.value(), reference.at(it.key()), path, unknown);
-    }
-  }
-}
-
 // What an options file must give for a key whose default is `value`, as an error message says
 // it; "" for a default of no particular kind (null).
 std::string KindOf(const Json& value) {
@@ -58,18 +45,22 @@ bool Fits(const Json& value, const Json& reference) {
   return expected.empty() || KindOf(value) == expected || (expected == "a number" && value.is_number());
 }
 
-void CollectMistyped(const Json& given, const Json& reference, const std::string& prefix,
-                     std::vector<std::string>* mistyped) {
+// One walk over `given` against the defaults: keys the defaults lack, and values of another kind.
+void CollectMismatches(const Json& given, const Json& reference, const std::string& prefix,
+                       std::vector<std::string>* unknown, std::vector<std::string>* mistyped) {
   if (!given.is_object() || !reference.is_object()) return;
   for (auto it = given.begin(); it != given.end(); ++it) {
-    if (!reference.contains(it.key())) continue;
     const std::string path = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (!reference.contains(it.key())) {
+      unknown->push_back(path);
+      continue;
+    }
     const Json& expected = reference.at(it.key());
     if (!Fits(it.value(), expected)) {
       mistyped->push_back(path + (expected.is_object() ? " is " : " must be ") + KindOf(expected) + ", got " +
                           it.value().dump());
     }
-    CollectMistyped(it.value(), expected, path, mistyped);
+    CollectMismatches(it.value(), expected, path, unknown, mistyped);
   }
 }
 
@@ -137,19 +128,14 @@ std::vector<std::string> LeafPaths(const Json& config) {
   return paths;
 }
 
-void RejectUnknownKeys(const Json& given, const Json& reference, const std::string& context) {
+void RejectMismatchedOptions(const Json& given, const Json& reference, const std::string& context) {
   if (!given.is_object()) throw Error(context + ": expected a JSON object");
-  std::vector<std::string> unknown;
-  CollectUnknown(given, reference, "", &unknown);
+  std::vector<std::string> unknown, mistyped;
+  CollectMismatches(given, reference, "", &unknown, &mistyped);
   if (!unknown.empty()) {
     throw Error(context + ": unknown option(s) " + Join(unknown, ", ") +
                 "; known options: " + Join(LeafPaths(reference), ", "));
   }
-}
-
-void RejectMistypedValues(const Json& given, const Json& reference, const std::string& context) {
-  std::vector<std::string> mistyped;
-  CollectMistyped(given, reference, "", &mistyped);
   if (!mistyped.empty()) throw Error(context + ": " + Join(mistyped, "; "));
 }
 

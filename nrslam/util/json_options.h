@@ -19,8 +19,10 @@ namespace nrslam {
 
 using Json = nlohmann::json;
 
-// Throws Error naming every key of `given` that `reference` (the serialised defaults) lacks.
-void RejectUnknownKeys(const Json& given, const Json& reference, const std::string& context);
+// Throws Error naming every key of `given` that `reference` (the serialised defaults) lacks,
+// or else every value whose kind (number, whole number, bool, string, list, group) differs
+// from the same key's in `reference`, with the value it got.
+void RejectMismatchedOptions(const Json& given, const Json& reference, const std::string& context);
 
 // Applies one `a.b.c=value` assignment to `config`. The key must already exist; the value is
 // parsed as the existing value's type (integer, number, bool, string, or a JSON/comma list
@@ -40,17 +42,12 @@ Json ReadJsonFile(const std::filesystem::path& file);
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
 std::vector<std::string> LeafPaths(const Json& config);
 
-// Throws Error naming every value of `given` whose kind (number, whole number, bool, string,
-// list, group) differs from the same key's in `reference`, with the value it got.
-void RejectMistypedValues(const Json& given, const Json& reference, const std::string& context);
-
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
 // rejecting unknown keys and values of the wrong kind, then Check()s.
 template <typename Options>
 Options OptionsFromJson(const Json& given, const std::string& context, const Options& base = Options{}) {
   const Json defaults = base;
-  RejectUnknownKeys(given, defaults, context);
-  RejectMistypedValues(given, defaults, context);
+  RejectMismatchedOptions(given, defaults, context);
   Json merged = defaults;
   merged.merge_patch(given);
   Options options = merged.get<Options>();
