@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -29,6 +30,7 @@
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/median.h"
 
 namespace nrslam {
 namespace {
@@ -473,7 +475,37 @@ struct MonocularOutcome {
   int new_points = 0;     // tracked points that were not in the initial map
   int deformable_candidates = 0;  // summed over metrics.csv
   int rigid_dba = 0, deformable_dba = 0;  // windows after the warm-up, by the model selected (run.log)
+  // Median |log(s·z / true depth)| of the new points on the frame each was first tracked,
+  // with s that frame's median ratio of true to estimated depth: how well new points are placed.
+  double new_point_log_depth_error = 0;
 };
+
+double NewPointLogDepthError(const std::vector<CsvPoint>& points, const SequenceReader& sequence, int init_frame) {
+  std::map<int, std::vector<const CsvPoint*>> by_frame;
+  for (const CsvPoint& p : points) by_frame[p.frame].push_back(&p);
+  std::set<PointId> seen;
+  std::vector<double> errors;
+  for (const auto& [frame, frame_points] : by_frame) {
+    const cv::Mat depth = sequence.ReadDepthMm(frame);
+    const auto truth = [&](const CsvPoint& p) {
+      const int u = std::clamp(static_cast<int>(std::lround(p.u)), 0, depth.cols - 1);
+      const int v = std::clamp(static_cast<int>(std::lround(p.v)), 0, depth.rows - 1);
+      return static_cast<double>(depth.at<float>(v, u));
+    };
+    std::vector<double> ratios;
+    for (const CsvPoint* p : frame_points) {
+      if (truth(*p) > 0) ratios.push_back(truth(*p) / p->z);
+    }
+    const double scale = ratios.empty() ? 0 : Median(ratios);
+    for (const CsvPoint* p : frame_points) {
+      if (frame != init_frame && !seen.count(p->id) && truth(*p) > 0 && scale > 0) {
+        errors.push_back(std::abs(std::log(scale * p->z / truth(*p))));
+      }
+      seen.insert(p->id);
+    }
+  }
+  return errors.empty() ? 0 : Median(errors);
+}
 
 int CountLines(const fs::path& file, const std::string& text) {
   std::ifstream in(file);
@@ -494,6 +526,8 @@ MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& op
   for (const CsvPoint& p : points) (p.frame == outcome.summary.init_frame ? initial : later).insert(p.id);
   for (PointId id : later) outcome.new_points += initial.count(id) == 0;
   outcome.deformable_candidates = static_cast<int>(SumColumn(folder / "run" / "metrics.csv", "deformable_candidates"));
+  outcome.new_point_log_depth_error =
+      NewPointLogDepthError(points, SequenceReader(folder / "sequence"), outcome.summary.init_frame);
   outcome.rigid_dba = CountLines(folder / "run" / "run.log", "DBA rigid");
   outcome.deformable_dba = CountLines(folder / "run" / "run.log", "DBA deformable");
   std::cout << preset << " monocular 320x240: init at " << outcome.summary.init_frame << ", " << outcome.new_points
@@ -573,6 +607,23 @@ TEST(MonocularRun, StarvingMapDropsTheTwoRayCheck) {
   std::cout << "deformable candidates with / without the two-ray check: " << reference.deformable_candidates << " / "
             << outcome.deformable_candidates << "\n";
   EXPECT_GT(outcome.deformable_candidates, reference.deformable_candidates);
+}
+
+TEST(MonocularRun, AgreementGateKeepsNewPointsThatMatchTheirTwoRayDepth) {
+  // A deformable fit whose depth disagrees with the two-ray depth got it from its seed, the
+  // neighbours' distance: far points down the lumen come out too near. Keeping only fits
+  // that agree leaves fewer new points, placed closer to the true depth.
+  SystemOptions off;
+  off.mapping.deformable_agreement_ratio = 0;
+  const MonocularOutcome reference = RunMonocular("sim-3", off);
+  const MonocularOutcome outcome = RunMonocular("sim-3", SystemOptions{});  // the default gate
+  ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
+  std::cout << "new points without / with the gate: " << reference.new_points << " / " << outcome.new_points
+            << ", median |log depth error| " << reference.new_point_log_depth_error << " / "
+            << outcome.new_point_log_depth_error << "\n";
+  EXPECT_GT(outcome.new_points, 0);
+  EXPECT_LT(outcome.deformable_candidates, reference.deformable_candidates);
+  EXPECT_LT(outcome.new_point_log_depth_error, 0.8 * reference.new_point_log_depth_error);
 }
 
 // New points are triangulated on every core (mapper.cc); the map must not depend on how many.

@@ -395,7 +395,17 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
       static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
     const std::optional<Triangulated> gate_pair =
         gate.shortest_span ? TriangulateShortestSpan(track, gate.check_reprojection) : ends;
-    if (const auto point = TriangulateDeformable(track, gate_pair, neighbours, map_scale); point && plausible(*point)) {
+    // The fit and the gate's two rays are different models of the same point; where their
+    // depths disagree, the fit's depth along a low-parallax ray is mostly its seed (the
+    // neighbours' distance), not a measurement.
+    const double ratio = options_.deformable_agreement_ratio;
+    const auto agrees = [&](const Eigen::Vector3d& point) {
+      if (!gate.check_agreement || ratio == 0) return true;
+      const double z = (newest.cam_from_world * point).z(), two_ray_z = (newest.cam_from_world * gate_pair->point).z();
+      return z <= ratio * two_ray_z && two_ray_z <= ratio * z;
+    };
+    if (const auto point = TriangulateDeformable(track, gate_pair, neighbours, map_scale);
+        point && plausible(*point) && agrees(*point)) {
       points.deformable = point;
     }
   }
@@ -411,6 +421,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   DeformableGate gate;
   gate.shortest_span = options_.deformable_gate_span == "shortest" || starving;
   gate.check_reprojection = !starving || options_.starving_two_ray_check;
+  gate.check_agreement = !starving;
   // Each candidate is its own small problem: they are solved on every core, each into its own
   // slot, and gathered in candidate order, so the outcome is the same as one at a time.
   const int count = static_cast<int>(result.candidates.size());

@@ -114,6 +114,7 @@ class Mapper {
   struct DeformableGate {
     bool shortest_span = false;
     bool check_reprojection = true;
+    bool check_agreement = true;  // mapping.deformable_agreement_ratio, when set
   };
   CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, const DeformableGate& gate,
                                        double map_scale) const;

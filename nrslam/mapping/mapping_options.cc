@@ -35,6 +35,8 @@ void MappingOptions::Check() const {
   CheckOption(rigid_dba_min_inliers >= 0 && rigid_dba_min_inliers <= 1 && rigid_dba_min_baseline >= 0, "mapping",
               "need rigid_dba_min_inliers in [0, 1] and rigid_dba_min_baseline >= 0");
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
+  CheckOption(deformable_agreement_ratio == 0 || deformable_agreement_ratio >= 1, "mapping",
+              "deformable_agreement_ratio must be 0 (off) or >= 1");
   CheckOption(deformable_gate_span == "oldest" || deformable_gate_span == "shortest", "mapping",
               "deformable_gate_span must be oldest or shortest, got '" + deformable_gate_span + "'");
   CheckOption(shortest_gate_below_fraction >= 0 && shortest_gate_below_fraction <= 1, "mapping",
