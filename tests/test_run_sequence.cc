@@ -39,8 +39,8 @@ namespace fs = std::filesystem;
 struct CsvPoint {
   int frame;
   PointId id;
-  double u, v, z;  // pixel and estimated depth (mm)
-  Eigen::Vector3d world;  // mm
+  double u, v, z;  // pixel and estimated depth (map units: mm from depth, arbitrary when monocular)
+  Eigen::Vector3d world;  // map units
 };
 
 std::vector<CsvPoint> ReadPointsCsv(const fs::path& path) {
