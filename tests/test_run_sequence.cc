@@ -476,7 +476,9 @@ struct MonocularOutcome {
   int deformable_candidates = 0;  // summed over metrics.csv
   int rigid_dba = 0, deformable_dba = 0;  // windows after the warm-up, by the model selected (run.log)
   // Median |log(s·z / true depth)| of the new points on the frame each was first tracked,
-  // with s that frame's median ratio of true to estimated depth: how well new points are placed.
+  // with s that frame's median ratio of true to estimated depth (the scale that centres log
+  // errors; the evaluator's least-squares scale leans towards the far points): how well new
+  // points are placed.
   double new_point_log_depth_error = 0;
 };
 
@@ -487,22 +489,18 @@ double NewPointLogDepthError(const std::vector<CsvPoint>& points, const Sequence
   std::vector<double> errors;
   for (const auto& [frame, frame_points] : by_frame) {
     const cv::Mat depth = sequence.ReadDepthMm(frame);
-    const auto truth = [&](const CsvPoint& p) {
-      const int u = std::clamp(static_cast<int>(std::lround(p.u)), 0, depth.cols - 1);
-      const int v = std::clamp(static_cast<int>(std::lround(p.v)), 0, depth.rows - 1);
-      return static_cast<double>(depth.at<float>(v, u));
-    };
+    std::vector<std::pair<double, double>> new_points;  // estimated and true depth
     std::vector<double> ratios;
     for (const CsvPoint* p : frame_points) {
-      if (truth(*p) > 0) ratios.push_back(truth(*p) / p->z);
+      const bool first_seen = seen.insert(p->id).second;
+      const std::optional<double> truth = SampleDepth(depth, {p->u, p->v});
+      if (!truth) continue;
+      ratios.push_back(*truth / p->z);
+      if (first_seen && frame != init_frame) new_points.emplace_back(p->z, *truth);
     }
-    const double scale = ratios.empty() ? 0 : Median(ratios);
-    for (const CsvPoint* p : frame_points) {
-      if (frame != init_frame && !seen.count(p->id) && truth(*p) > 0 && scale > 0) {
-        errors.push_back(std::abs(std::log(scale * p->z / truth(*p))));
-      }
-      seen.insert(p->id);
-    }
+    if (new_points.empty()) continue;
+    const double scale = Median(ratios);
+    for (const auto& [estimated, truth] : new_points) errors.push_back(std::abs(std::log(scale * estimated / truth)));
   }
   return errors.empty() ? 0 : Median(errors);
 }

@@ -379,14 +379,15 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
   // A new point lies on the surface its neighbours span: its depth now is within
   // max_depth_ratio of theirs. Low parallax leaves a triangulated depth free to run off
   // (measured on lap-lobes: points at 4 % of the median depth, which then drag the map).
+  const auto depth_now = [&](const Eigen::Vector3d& point) { return (newest.cam_from_world * point).z(); };
   double nearest = std::numeric_limits<double>::infinity(), farthest = 0;
   for (PointId id : neighbours) {
-    const double z = (newest.cam_from_world * newest.points.at(id).second).z();
+    const double z = depth_now(newest.points.at(id).second);
     nearest = std::min(nearest, z);
     farthest = std::max(farthest, z);
   }
   const auto plausible = [&](const Eigen::Vector3d& point) {
-    const double z = (newest.cam_from_world * point).z();
+    const double z = depth_now(point);
     return z * options_.max_depth_ratio >= nearest && z <= options_.max_depth_ratio * farthest;
   };
   const std::optional<Triangulated> ends = TriangulatePair(track, 0, track.frames.size() - 1);
@@ -395,14 +396,11 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
       static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
     const std::optional<Triangulated> gate_pair =
         gate.shortest_span ? TriangulateShortestSpan(track, gate.check_reprojection) : ends;
-    // The fit and the gate's two rays are different models of the same point; where their
-    // depths disagree, the fit's depth along a low-parallax ray is mostly its seed (the
-    // neighbours' distance), not a measurement.
-    const double ratio = options_.deformable_agreement_ratio;
+    // The fit and the gate's two rays model the same point differently; where their depths
+    // disagree, the fit's depth is mostly its seed (mapping.deformable_agreement_ratio).
     const auto agrees = [&](const Eigen::Vector3d& point) {
-      if (!gate.check_agreement || ratio == 0) return true;
-      const double z = (newest.cam_from_world * point).z(), two_ray_z = (newest.cam_from_world * gate_pair->point).z();
-      return z <= ratio * two_ray_z && two_ray_z <= ratio * z;
+      const double ratio = gate.agreement_ratio, z = depth_now(point), two_ray_z = depth_now(gate_pair->point);
+      return ratio == 0 || (z <= ratio * two_ray_z && two_ray_z <= ratio * z);
     };
     if (const auto point = TriangulateDeformable(track, gate_pair, neighbours, map_scale);
         point && plausible(*point) && agrees(*point)) {
@@ -421,7 +419,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   DeformableGate gate;
   gate.shortest_span = options_.deformable_gate_span == "shortest" || starving;
   gate.check_reprojection = !starving || options_.starving_two_ray_check;
-  gate.check_agreement = !starving;
+  gate.agreement_ratio = starving ? 0 : options_.deformable_agreement_ratio;
   // Each candidate is its own small problem: they are solved on every core, each into its own
   // slot, and gathered in candidate order, so the outcome is the same as one at a time.
   const int count = static_cast<int>(result.candidates.size());

@@ -114,7 +114,7 @@ class Mapper {
   struct DeformableGate {
     bool shortest_span = false;
     bool check_reprojection = true;
-    bool check_agreement = true;  // mapping.deformable_agreement_ratio, when set
+    double agreement_ratio = 0;  // this frame's mapping.deformable_agreement_ratio; 0 = no check
   };
   CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, const DeformableGate& gate,
                                        double map_scale) const;
