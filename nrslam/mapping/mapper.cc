@@ -214,6 +214,24 @@ Eigen::Vector3d Mapper::WorldRay(const CandidateTrack& track, size_t i) const {
   return track.frames[i]->cam_from_world.rotation.conjugate() * camera_.Unproject(track.pixels[i]).normalized();
 }
 
+double Mapper::EpipolarDeviationRatio(const CandidateTrack& track) const {
+  const Eigen::Vector3d oldest_centre = track.frames.front()->cam_from_world.Inverse().translation;
+  const Eigen::Vector3d oldest_ray = WorldRay(track, 0);
+  double sum_squares = 0;
+  int count = 0;
+  for (size_t i = 1; i < track.frames.size(); ++i) {
+    const Eigen::Vector3d normal =
+        (track.frames[i]->cam_from_world.Inverse().translation - oldest_centre).cross(oldest_ray);
+    if (normal.squaredNorm() == 0) continue;  // no baseline, no epipolar plane
+    const double sine = normal.normalized().dot(WorldRay(track, i));
+    sum_squares += sine * sine;
+    ++count;
+  }
+  const double parallax = std::acos(std::clamp(oldest_ray.dot(WorldRay(track, track.frames.size() - 1)), -1.0, 1.0));
+  if (count == 0 || parallax == 0) return std::numeric_limits<double>::infinity();
+  return std::asin(std::min(1.0, std::sqrt(sum_squares / count))) / parallax;
+}
+
 std::optional<Triangulated> Mapper::TriangulatePair(const CandidateTrack& track, size_t a, size_t b,
                                                     bool check_reprojection) const {
   const Snapshot& first = *track.frames[a];
@@ -393,7 +411,8 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
   const std::optional<Triangulated> ends = TriangulatePair(track, 0, track.frames.size() - 1);
   if (const auto point = TriangulateRigid(track, ends, map_scale); point && plausible(*point)) points.rigid = point;
   if (!rigid_ && options_.deformable_triangulation &&
-      static_cast<int>(track.frames.size()) >= options_.deformable_min_track) {
+      static_cast<int>(track.frames.size()) >= options_.deformable_min_track &&
+      (gate.max_epipolar_ratio == 0 || EpipolarDeviationRatio(track) <= gate.max_epipolar_ratio)) {
     const std::optional<Triangulated> gate_pair =
         gate.shortest_span ? TriangulateShortestSpan(track, gate.check_reprojection) : ends;
     // The fit and the gate's two rays model the same point differently; where their depths
@@ -420,6 +439,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
   gate.shortest_span = options_.deformable_gate_span == "shortest" || starving;
   gate.check_reprojection = !starving || options_.starving_two_ray_check;
   gate.agreement_ratio = starving ? 0 : options_.deformable_agreement_ratio;
+  gate.max_epipolar_ratio = starving ? options_.starving_max_epipolar_ratio : options_.deformable_max_epipolar_ratio;
   // Each candidate is its own small problem: they are solved on every core, each into its own
   // slot, and gathered in candidate order, so the outcome is the same as one at a time.
   const int count = static_cast<int>(result.candidates.size());

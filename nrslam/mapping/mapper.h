@@ -115,11 +115,15 @@ class Mapper {
     bool shortest_span = false;
     bool check_reprojection = true;
     double agreement_ratio = 0;  // this frame's mapping.deformable_agreement_ratio; 0 = no check
+    double max_epipolar_ratio = 0;  // this frame's mapping.deformable_max_epipolar_ratio; 0 = no check
   };
   CandidatePoints TriangulateCandidate(const CandidateObservation& candidate, const DeformableGate& gate,
                                        double map_scale) const;
   // Observation i's viewing ray, in the world frame.
   Eigen::Vector3d WorldRay(const CandidateTrack& track, size_t i) const;
+  // The rms angle of the track's later rays to their epipolar planes with its oldest ray, over
+  // the angle between its oldest and newest rays (infinite without parallax).
+  double EpipolarDeviationRatio(const CandidateTrack& track) const;
   // The rays of observations a and b met in the middle, if both lie in front and (when
   // check_reprojection) it reprojects within max_reprojection_px2 in both views. Over the
   // first and last observations: the rigid answer, and the deformable triangulation's

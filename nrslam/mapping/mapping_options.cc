@@ -37,6 +37,8 @@ void MappingOptions::Check() const {
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
   CheckOption(deformable_agreement_ratio == 0 || deformable_agreement_ratio >= 1, "mapping",
               "deformable_agreement_ratio must be 0 (off) or >= 1");
+  CheckOption(deformable_max_epipolar_ratio >= 0 && starving_max_epipolar_ratio >= 0, "mapping",
+              "deformable_max_epipolar_ratio and starving_max_epipolar_ratio must be >= 0 (0 = off)");
   CheckOption(deformable_gate_span == "oldest" || deformable_gate_span == "shortest", "mapping",
               "deformable_gate_span must be oldest or shortest, got '" + deformable_gate_span + "'");
   CheckOption(shortest_gate_below_fraction >= 0 && shortest_gate_below_fraction <= 1, "mapping",

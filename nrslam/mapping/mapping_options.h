@@ -110,6 +110,17 @@ struct MappingOptions {
   // 0 = off (the reference). 1.25 measured better than off on 18 of 21 colon renderings and
   // 5 of 6 lap-lobes renderings (README, "Mapping").
   double deformable_agreement_ratio = 1.25;
+  // A deformable candidate is fitted only if its track's rays stay near their epipolar planes
+  // with its oldest ray: their rms angle to those planes, over the oldest-to-newest parallax,
+  // at most this. A rigid point's rays lie on those planes; what the tissue moves a track
+  // across them it also moves it along them, and that false parallax puts the point too near
+  // (down the lumen of monocular sim-3, 2-4x too near). 0 = off (the reference). 0.15
+  // measured better than off on 16 of 21 colon renderings and 6 of 6 lap-lobes renderings.
+  double deformable_max_epipolar_ratio = 0.15;
+  // The same on starving frames (shortest_gate_below_fraction), looser because the map needs
+  // points there: at 0 (no check) the points those frames make undid most of the gain, at 0.2
+  // the 300-frame sim-3 run had 6 frames under 100 tracked points (README, "Mapping").
+  double starving_max_epipolar_ratio = 0.3;
   double deformable_min_parallax_px = 5;
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
   int deformable_iterations = 10;
@@ -125,7 +136,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_triangulation, deformable_gate_span,
                                                 shortest_gate_below_fraction, starving_two_ray_check, deformable_min_track,
-                                                deformable_agreement_ratio, deformable_min_parallax_px,
+                                                deformable_agreement_ratio, deformable_max_epipolar_ratio, starving_max_epipolar_ratio, deformable_min_parallax_px,
                                                 flow_sigma, deformable_iterations, flow_outlier_chi2,
                                                 reprojection_outlier_chi2, model_selection_factor)
 
