@@ -118,8 +118,9 @@ struct MappingOptions {
   // measured better than off on 16 of 21 colon renderings and 6 of 6 lap-lobes renderings.
   double deformable_max_epipolar_ratio = 0.15;
   // The same on starving frames (shortest_gate_below_fraction), looser because the map needs
-  // points there: at 0 (no check) the points those frames make undid most of the gain, at 0.2
-  // the 300-frame sim-3 run had 6 frames under 100 tracked points (README, "Mapping").
+  // points there: at 0 (no check) the points those frames made undid most of the gain; at the
+  // main ratio (0.1 or 0.15) or 0.2 the 300-frame sim-3 run had 6-99 frames under 100 tracked
+  // points after frame 30, at 0.3 none (README, "Mapping").
   double starving_max_epipolar_ratio = 0.3;
   double deformable_min_parallax_px = 5;
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
