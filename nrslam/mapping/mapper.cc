@@ -215,19 +215,20 @@ Eigen::Vector3d Mapper::WorldRay(const CandidateTrack& track, size_t i) const {
 }
 
 double Mapper::EpipolarDeviationRatio(const CandidateTrack& track) const {
-  const Eigen::Vector3d oldest_centre = track.frames.front()->cam_from_world.Inverse().translation;
-  const Eigen::Vector3d oldest_ray = WorldRay(track, 0);
+  const Rigid3 world_from_oldest = track.frames.front()->cam_from_world.Inverse();
+  const Eigen::Vector3d oldest_bearing = camera_.Unproject(track.pixels.front()).normalized();
   double sum_squares = 0;
   int count = 0;
   for (size_t i = 1; i < track.frames.size(); ++i) {
-    const Eigen::Vector3d normal =
-        (track.frames[i]->cam_from_world.Inverse().translation - oldest_centre).cross(oldest_ray);
-    if (normal.squaredNorm() == 0) continue;  // no baseline, no epipolar plane
-    const double sine = normal.normalized().dot(WorldRay(track, i));
+    const Rigid3 current_from_oldest = track.frames[i]->cam_from_world * world_from_oldest;
+    if (current_from_oldest.translation.squaredNorm() == 0) continue;  // no baseline, no epipolar plane
+    // Summed as sines, then turned back into an angle: the rms angle for the small angles here.
+    const double sine = std::sin(EpipolarAngle(EssentialFromPose(current_from_oldest), oldest_bearing,
+                                               camera_.Unproject(track.pixels[i]).normalized()));
     sum_squares += sine * sine;
     ++count;
   }
-  const double parallax = std::acos(std::clamp(oldest_ray.dot(WorldRay(track, track.frames.size() - 1)), -1.0, 1.0));
+  const double parallax = std::acos(std::clamp(WorldRay(track, 0).dot(WorldRay(track, track.frames.size() - 1)), -1.0, 1.0));
   if (count == 0 || parallax == 0) return std::numeric_limits<double>::infinity();
   return std::asin(std::min(1.0, std::sqrt(sum_squares / count))) / parallax;
 }
