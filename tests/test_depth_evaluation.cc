@@ -131,13 +131,19 @@ TEST(DepthEvaluation, SequenceAggregates) {
   EXPECT_NEAR(metrics.rmse_flat_mm, 70.0 / 3.0, 1e-12);
 }
 
+// Ground truth for the common-point tests: a slanted plane, 80 mm + 1 mm per column.
+cv::Mat SlantedPlaneDepth() {
+  cv::Mat depth(40, 60, CV_32F);
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) depth.at<float>(y, x) = 80.0f + x;
+  }
+  return depth;
+}
+
 // Run a keeps ten exact points and ten bad ones; run b only the ten exact ones (and one of its
 // own). On their own points a scores badly and b perfectly; on the common points both are exact.
 TEST(CommonPoints, BothRunsAreScoredOnThePointsTheyShare) {
-  cv::Mat depth(40, 60, CV_32F);
-  for (int y = 0; y < depth.rows; ++y) {
-    for (int x = 0; x < depth.cols; ++x) depth.at<float>(y, x) = 80.0f + x;  // a slanted plane, mm
-  }
+  const cv::Mat depth = SlantedPlaneDepth();
   const auto truth = [&](int x, int y) { return static_cast<double>(depth.at<float>(y, x)); };
   RunPoints a, b;
   for (int id = 0; id < 20; ++id) {
@@ -160,6 +166,35 @@ TEST(CommonPoints, BothRunsAreScoredOnThePointsTheyShare) {
   EXPECT_NEAR(comparison.b_own.rmse_mm, 0.0, 1e-9);
   EXPECT_NEAR(comparison.a_common.rmse_mm, 0.0, 1e-9);
   EXPECT_NEAR(comparison.b_common.rmse_mm, 0.0, 1e-9);
+}
+
+// Two monocular runs number their new points in the order each made them, so one id can name
+// different points. Ids 20-22 are first reported by b a frame earlier, ids 23-24 a pixel away
+// from where a first reports them; a puts all five 8 mm off. Paired, they would spoil a's common
+// score; they are counted and left out.
+TEST(CommonPoints, AnIdThatNamesDifferentTracksInTheTwoRunsIsNotCommon) {
+  const cv::Mat depth = SlantedPlaneDepth();
+  const auto truth = [&](int x, int y) { return static_cast<double>(depth.at<float>(y, x)); };
+  RunPoints a, b;
+  for (int id = 0; id < 10; ++id) {
+    const int x = 2 + 2 * id, y = 5 + id;
+    a[3][id] = {cv::Point2d(x, y), truth(x, y) / 2.0};
+    b[3][id] = {cv::Point2d(x, y), truth(x, y) * 3.0};
+  }
+  for (int id = 20; id < 25; ++id) {
+    const int x = 2 * id - 10, y = 30;
+    a[3][id] = {cv::Point2d(x, y), (truth(x, y) + 8.0) / 2.0};
+    b[3][id] = {cv::Point2d(id < 23 ? x : x + 1, y), truth(id < 23 ? x : x + 1, y) * 3.0};
+    if (id < 23) b[2][id] = b[3][id];
+  }
+  const CommonPointsComparison comparison =
+      CompareOnCommonPoints(a, b, [&](int) { return depth; }, EvaluationOptions{});
+  EXPECT_EQ(comparison.mismatched_ids, 5);
+  EXPECT_EQ(comparison.frames, 1);
+  EXPECT_DOUBLE_EQ(comparison.mean_common_points, 10);
+  EXPECT_NEAR(comparison.a_common.rmse_mm, 0.0, 1e-9);
+  EXPECT_NEAR(comparison.b_common.rmse_mm, 0.0, 1e-9);
+  EXPECT_GT(comparison.a_own.rmse_mm, 1.0);
 }
 
 }  // namespace

@@ -825,6 +825,33 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   fs::remove_all(folder);
 }
 
+// Lost in two black frames, the run starts a second map from depth at frame 7. Each map numbers
+// its points from 0; points.csv numbers the second map's after the first's, so an id names one
+// point of the run (nrslam_eval compare relies on it).
+TEST(RunSequenceErrors, ASecondMapNumbersItsPointsAfterTheFirst) {
+  const fs::path folder = UniqueTempFolder("nrslam_second_map");
+  fs::remove_all(folder);
+  SimulateSmall("sim-0", 10, 320, 240, folder);
+  for (int frame = 5; frame < 7; ++frame) {
+    cv::imwrite((folder / "rgb" / FrameFileName(frame)).string(), cv::Mat::zeros(240, 320, CV_8UC3));
+  }
+  SystemOptions options = TrackingExperiment();
+  options.run.reinitialise_after_loss = true;
+  RunSequence(folder, options, folder / "run");
+  std::set<int64_t> first_map, second_map;
+  for (const auto& row : ReadCsv(folder / "run" / "points.csv")) {
+    const int frame = static_cast<int>(std::stod(row.at("frame")));
+    (frame < 5 ? first_map : second_map).insert(std::stoll(row.at("point_id")));
+  }
+  const auto metrics = ReadCsv(folder / "run" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 10u);
+  EXPECT_EQ(metrics[9].at("map"), "2");
+  ASSERT_FALSE(first_map.empty());
+  ASSERT_FALSE(second_map.empty());
+  EXPECT_LT(*first_map.rbegin(), *second_map.begin());
+  fs::remove_all(folder);
+}
+
 // A view that goes black (the light off, the lens covered) loses the track on its first black
 // frame: no patch is matched on a flat image. The summary says where and why.
 TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {

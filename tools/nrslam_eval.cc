@@ -68,7 +68,12 @@ int Compare(const std::filesystem::path& a, const std::filesystem::path& b) {
   const nrslam::CommonPointsComparison comparison = nrslam::CompareRunFolders(a, b);
   if (comparison.frames == 0) throw nrslam::Error("no frame that both runs report could be evaluated");
   std::cout << comparison.frames << " frame(s) both runs report; " << nrslam::FormatFixed(comparison.mean_common_points, 0)
-            << " points per frame in common\n\n";
+            << " points per frame in common\n";
+  if (comparison.mismatched_ids > 0) {
+    std::cout << comparison.mismatched_ids << " id(s) both runs report name different points (first reported in "
+              << "another frame or place) and are left out\n";
+  }
+  std::cout << '\n';
   nrslam::TextTable table({"run", "points/frame", "own RMSE mm", "common RMSE mm"});
   table.AddRow({a.string(), nrslam::FormatFixed(comparison.mean_points_a, 0), nrslam::FormatFixed(comparison.a_own.rmse_mm, 3),
                 nrslam::FormatFixed(comparison.a_common.rmse_mm, 3)});

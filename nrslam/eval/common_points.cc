@@ -1,5 +1,6 @@
 #include "nrslam/eval/common_points.h"
 
+#include <set>
 #include <vector>
 
 namespace nrslam {
@@ -11,12 +12,43 @@ std::vector<DepthPoint> Values(const FramePoints& points) {
   return values;
 }
 
+struct FirstReport {
+  int frame;
+  cv::Point2d pixel;
+};
+
+std::map<int64_t, FirstReport> FirstReports(const RunPoints& run) {
+  std::map<int64_t, FirstReport> first;
+  for (const auto& [frame, points] : run) {  // frames in order: emplace keeps the earliest
+    for (const auto& [id, point] : points) first.emplace(id, FirstReport{frame, point.pixel});
+  }
+  return first;
+}
+
+// The ids both runs report for the same track.
+std::set<int64_t> SharedTracks(const RunPoints& a, const RunPoints& b, int* mismatched) {
+  const std::map<int64_t, FirstReport> first_b = FirstReports(b);
+  std::set<int64_t> shared;
+  *mismatched = 0;
+  for (const auto& [id, report] : FirstReports(a)) {
+    const auto other = first_b.find(id);
+    if (other == first_b.end()) continue;
+    if (other->second.frame == report.frame && cv::norm(other->second.pixel - report.pixel) <= kSameTrackPixels) {
+      shared.insert(id);
+    } else {
+      ++*mismatched;
+    }
+  }
+  return shared;
+}
+
 }  // namespace
 
 CommonPointsComparison CompareOnCommonPoints(const RunPoints& a, const RunPoints& b,
                                              const std::function<cv::Mat(int frame)>& depth_mm,
                                              const EvaluationOptions& options) {
   CommonPointsComparison comparison;
+  const std::set<int64_t> shared = SharedTracks(a, b, &comparison.mismatched_ids);
   std::vector<FrameEvaluation> a_own, b_own, a_common, b_common;
   double points_a = 0, points_b = 0, common = 0;
   for (const auto& [frame, points] : a) {
@@ -25,7 +57,7 @@ CommonPointsComparison CompareOnCommonPoints(const RunPoints& a, const RunPoints
     std::vector<DepthPoint> common_a, common_b;
     for (const auto& [id, point] : points) {
       const auto match = other->second.find(id);
-      if (match == other->second.end()) continue;
+      if (match == other->second.end() || shared.count(id) == 0) continue;
       common_a.push_back(point);
       common_b.push_back(match->second);
     }

@@ -121,12 +121,18 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   MonocularInitialiser initialiser(camera, options.frontend, options.tracking.max_points, options.initialisation);
   const bool monocular = options.run.init == "monocular";
   int maps = 0;  // maps started so far: a monocular run starts a new one after each loss
+  // Each map numbers its points from 0; points.csv offsets them by the points of the run's
+  // earlier maps, so that an id names one point of the whole run.
+  int64_t id_base = 0;
+  int64_t map_points = 0;  // points of the current map, as of the last frame tracked
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
   const auto start_map = [&](const FrameResult& started, const std::optional<Keyframe>& reference) {
     if (options.run.mapping) mapper.StartMap(started, tracker, reference);
     ++maps;
+    id_base += map_points;
+    map_points = 0;
     if (summary.init_frame < 0) summary.init_frame = started.frame;
   };
   std::vector<FrameEvaluation> evaluations;
@@ -207,11 +213,12 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         aligned_maps.back().groundtruth.push_back(
             reader.groundtruth()[static_cast<size_t>(frame)].world_from_camera.translation);
       }
+      map_points = static_cast<int64_t>(tracker.map().size());
       for (const TrackedPoint& point : result.points) {
         const Eigen::Vector3d world = tracker.map().point(point.id).position;
         const double z = (result.cam_from_world * world).z();
         depth_points.push_back({cv::Point2d(point.pixel.x, point.pixel.y), z});
-        points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
+        points_csv << frame << ',' << id_base + point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
                    << world.x() << ',' << world.y() << ',' << world.z() << ','
                    << (point.reassociated ? "reassociated" : "tracked") << '\n';
       }
