@@ -446,6 +446,7 @@ TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
   EXPECT_EQ(cells[4], "0.17");
   EXPECT_EQ(cells[5], "4 / 2");
   EXPECT_EQ(cells[9], "0.50");
+  EXPECT_EQ(cells[14], "-");  // no points.csv in these run folders: no common points
   std::stringstream table;
   PrintRigidComparison(comparisons, table);
   EXPECT_NE(table.str().find("a-rigid"), std::string::npos) << table.str();
@@ -513,6 +514,12 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
     EXPECT_NEAR(comparisons[0].common.a_mm, results[0].rmse_mm, 1e-6);
     EXPECT_NEAR(comparisons[0].common.b_mm, results[2].rmse_mm, 1e-6);
   }
+  // One map from depth: every point both report is the same track.
+  const CommonPointsComparison& same = comparisons[0].same_points;
+  EXPECT_EQ(same.frames, comparisons[0].common.frames);
+  EXPECT_EQ(same.mismatched_ids, 0);
+  EXPECT_GT(same.mean_common_points, 8.0);
+  EXPECT_LE(same.mean_common_points, std::min(same.mean_points_a, same.mean_points_b));
 
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,
   // and the failed sequence is shown as such.

@@ -64,12 +64,18 @@ std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const 
     if (plan.runs[i].is_external() || IsRigid(plan.runs[i]) || results[i].status == "failed" || !results[i].evaluated()) continue;
     const auto rigid = rigid_runs.find(BaselineKey(plan.runs[i]));
     if (rigid == rigid_runs.end()) continue;
-    RigidComparison comparison{results[i], results[rigid->second], {}};
+    RigidComparison comparison{results[i], results[rigid->second], {}, {}};
+    const std::filesystem::path& deformable_folder = plan.runs[i].run_folder;
+    const std::filesystem::path& rigid_folder = plan.runs[rigid->second].run_folder;
     try {
-      comparison.common = MeanOverCommonFrames(ReadFrameRmse(plan.runs[i].run_folder),
-                                               ReadFrameRmse(plan.runs[rigid->second].run_folder));
+      comparison.common = MeanOverCommonFrames(ReadFrameRmse(deformable_folder), ReadFrameRmse(rigid_folder));
     } catch (const Error&) {
       // A run folder without metrics.csv (e.g. merged from elsewhere without it): no common frames.
+    }
+    try {
+      comparison.same_points = CompareRunFolders(deformable_folder, rigid_folder);
+    } catch (const Error&) {
+      // Likewise without points.csv or config.json, or its sequence is gone: no common points.
     }
     comparisons.push_back(comparison);
   }
@@ -78,11 +84,14 @@ std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const 
 
 std::vector<std::string> RigidComparisonHeader() {
   return {"deformable run", "rigid run",     "def mm",        "rigid mm",        "ratio",
-          "tracked def / rigid", "common frames", "def mm common", "rigid mm common", "ratio common"};
+          "tracked def / rigid", "common frames", "def mm common", "rigid mm common", "ratio common",
+          "same-point frames", "same points/frame", "def mm same points", "rigid mm same points",
+          "ratio same points"};
 }
 
 std::vector<std::string> RigidComparisonCells(const RigidComparison& c) {
   const bool common = c.common.frames > 0;
+  const bool same = c.same_points.frames > 0;
   return {RunKey(c.deformable),
           RunKey(c.rigid),
           FormatFixed(c.deformable.rmse_mm, 3),
@@ -92,13 +101,19 @@ std::vector<std::string> RigidComparisonCells(const RigidComparison& c) {
           std::to_string(c.common.frames),
           common ? FormatFixed(c.common.a_mm, 3) : "-",
           common ? FormatFixed(c.common.b_mm, 3) : "-",
-          common ? Ratio(c.common.b_mm, c.common.a_mm) : "-"};
+          common ? Ratio(c.common.b_mm, c.common.a_mm) : "-",
+          std::to_string(c.same_points.frames),
+          same ? FormatFixed(c.same_points.mean_common_points, 0) : "-",
+          same ? FormatFixed(c.same_points.a_common.rmse_mm, 3) : "-",
+          same ? FormatFixed(c.same_points.b_common.rmse_mm, 3) : "-",
+          same ? Ratio(c.same_points.b_common.rmse_mm, c.same_points.a_common.rmse_mm) : "-"};
 }
 
 void PrintRigidComparison(const std::vector<RigidComparison>& comparisons, std::ostream& out) {
   if (comparisons.empty()) return;
   out << "\nDeformable against rigid: the same sequence and options but tracking.rigid. Ratio = rigid / deformable\n"
-         "RMSE, above 1 where the deformable run is more accurate; \"common\": both over the frames both evaluated.\n";
+         "RMSE, above 1 where the deformable run is more accurate; \"common\": both over the frames both evaluated;\n"
+         "\"same points\": both on the points both report (the same tracks), over the frames where both have enough.\n";
   TextTable table(RigidComparisonHeader());
   for (const RigidComparison& c : comparisons) table.AddRow(RigidComparisonCells(c));
   table.Print(out);
@@ -107,13 +122,21 @@ void PrintRigidComparison(const std::vector<RigidComparison>& comparisons, std::
 void WriteRigidComparison(const std::vector<RigidComparison>& comparisons, const std::filesystem::path& file) {
   std::ofstream csv(file);
   csv << "deformable_run,rigid_run,deformable_rmse_mm,rigid_rmse_mm,deformable_frames_tracked,rigid_frames_tracked,"
-         "frames_total,common_frames,deformable_common_rmse_mm,rigid_common_rmse_mm\n";
+         "frames_total,common_frames,deformable_common_rmse_mm,rigid_common_rmse_mm,same_points_frames,"
+         "same_points_per_frame,deformable_same_points_rmse_mm,rigid_same_points_rmse_mm\n";
   for (const RigidComparison& c : comparisons) {
     csv << CsvField(RunKey(c.deformable)) << ',' << CsvField(RunKey(c.rigid)) << ',' << c.deformable.rmse_mm << ','
         << c.rigid.rmse_mm << ',' << c.deformable.frames_tracked << ',' << c.rigid.frames_tracked << ','
         << c.deformable.frames_total << ',' << c.common.frames << ',';
     if (c.common.frames > 0) csv << c.common.a_mm << ',' << c.common.b_mm;
     else csv << ',';
+    csv << ',' << c.same_points.frames << ',';
+    if (c.same_points.frames > 0) {
+      csv << c.same_points.mean_common_points << ',' << c.same_points.a_common.rmse_mm << ','
+          << c.same_points.b_common.rmse_mm;
+    } else {
+      csv << ",,";
+    }
     csv << '\n';
   }
 }

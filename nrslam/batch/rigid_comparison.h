@@ -2,7 +2,9 @@
 // same sequence whose options differ only in `tracking.rigid` (e.g. the manifest's "sim-3"
 // and "sim-3-rigid", at the same sweep point). Each run's own RMSE covers its own frames, and a
 // rigid run on a deforming scene often stops early, scored only on the first frames, before
-// much has moved. So both are also scored over the frames both evaluated.
+// much has moved. So both are also scored over the frames both evaluated, and on the points
+// both report (the same tracks, eval/common_points.h): rigid flags much of a deforming scene
+// as outliers and is scored on what still fits.
 #pragma once
 
 #include <filesystem>
@@ -13,6 +15,7 @@
 
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/results.h"
+#include "nrslam/eval/common_points.h"
 
 namespace nrslam {
 
@@ -28,7 +31,8 @@ CommonFramesRmse MeanOverCommonFrames(const std::map<int, double>& a, const std:
 
 struct RigidComparison {
   RunResult deformable, rigid;
-  CommonFramesRmse common;  // deformable as a, rigid as b
+  CommonFramesRmse common;             // deformable as a, rigid as b
+  CommonPointsComparison same_points;  // likewise; no frames when a run folder lacks points.csv
 };
 
 // Pairs every deformable run with the first rigid run of the same sequence folder whose
