@@ -1,6 +1,7 @@
 #include "nrslam/batch/rigid_comparison.h"
 
 #include <cmath>
+#include <exception>
 #include <fstream>
 
 #include "nrslam/batch/run_folder.h"
@@ -74,8 +75,9 @@ std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const 
     }
     try {
       comparison.same_points = CompareRunFolders(deformable_folder, rigid_folder);
-    } catch (const Error&) {
-      // Likewise without points.csv or config.json, or its sequence is gone: no common points.
+    } catch (const std::exception&) {
+      // Likewise without points.csv, with a config.json that does not parse or its sequence
+      // gone: no common points, and the table is still printed.
     }
     comparisons.push_back(comparison);
   }
