@@ -200,7 +200,9 @@ std::string RigidSection(const std::vector<RigidComparison>& comparisons) {
   html << "<section><h2>Deformable against rigid</h2><p>Each deformable run beside the rigid run of the same "
           "sequence and options. Ratio = rigid / deformable: above 1, the deformable run is more accurate. "
           "\"Common\": both runs scored over the frames both evaluated (a rigid run that stops early is "
-          "otherwise scored on the first frames only).</p>";
+          "otherwise scored on the first frames only). \"Same points\": both runs scored on the points both "
+          "report, the same tracks, over the frames where both have enough of them (a rigid run flags much "
+          "of a deforming scene as outliers and is otherwise scored on the points that still fit).</p>";
   std::vector<std::vector<std::string>> rows;
   for (const RigidComparison& comparison : comparisons) rows.push_back(RigidComparisonCells(comparison));
   html << HtmlTable(RigidComparisonHeader(), rows) << "</section>\n";
@@ -216,7 +218,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>nrslam evaluation</title>\n"
           "<style>body{font-family:sans-serif;margin:24px;max-width:1200px}table{border-collapse:collapse}"
           "td,th{padding:3px 10px;border-bottom:1px solid #ddd;text-align:right}td:first-child,th:first-child"
-          "{text-align:left}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
+          "{text-align:left}td:nth-child(-n+2){white-space:nowrap}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
           "figure{margin:0}section{margin-top:28px}</style></head><body>\n<h1>nrslam evaluation</h1>\n";
   html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
           "<th>flat mm</th><th>ATE mm</th><th>fps</th></tr>\n";
