@@ -825,9 +825,10 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   fs::remove_all(folder);
 }
 
-// Lost in two black frames, the run starts a second map from depth at frame 7. Each map numbers
-// its points from 0; points.csv numbers the second map's after the first's, so an id names one
-// point of the run (nrslam_eval compare relies on it).
+// Lost in two black frames, the run starts a second map from depth once the view is back (the
+// `map` column counts 2 by the last frame). Each map numbers its points from 0; points.csv
+// numbers the second map's after the first's, so an id names one point of the run
+// (nrslam_eval compare relies on it).
 TEST(RunSequenceErrors, ASecondMapNumbersItsPointsAfterTheFirst) {
   const fs::path folder = UniqueTempFolder("nrslam_second_map");
   fs::remove_all(folder);
