@@ -228,7 +228,8 @@ double Mapper::EpipolarDeviationRatio(const CandidateTrack& track) const {
     sum_squares += sine * sine;
     ++count;
   }
-  const double parallax = std::acos(std::clamp(WorldRay(track, 0).dot(WorldRay(track, track.frames.size() - 1)), -1.0, 1.0));
+  const Eigen::Vector3d oldest_ray = world_from_oldest.rotation * oldest_bearing;  // WorldRay(track, 0)
+  const double parallax = std::acos(std::clamp(oldest_ray.dot(WorldRay(track, track.frames.size() - 1)), -1.0, 1.0));
   if (count == 0 || parallax == 0) return std::numeric_limits<double>::infinity();
   return std::asin(std::min(1.0, std::sqrt(sum_squares / count))) / parallax;
 }
