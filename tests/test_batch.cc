@@ -465,6 +465,20 @@ TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
   EXPECT_EQ(RunKey(twins[0].deformable), "s [rigid=false]");
   EXPECT_EQ(RunKey(twins[0].rigid), "s [rigid=true]");
   EXPECT_EQ(RigidComparisonCells(twins[0])[9], "2.00");
+
+  // Tallied: "a" is worse than its rigid run by its own RMSE (1.5 against 0.25) and over the
+  // common frames (0.5 against 0.25); the twin "s", counted twice, is better both ways (0.5
+  // against 1.0). Neither has points.csv, so the same-points count is empty.
+  const std::vector<RigidComparison> three = {comparisons[0], twins[0], twins[0]};
+  const RigidComparisonTally tally = TallyRigidComparisons(three);
+  EXPECT_EQ(tally.own.ToString(), "2 / 0 / 1");
+  EXPECT_EQ(tally.common.ToString(), "2 / 0 / 1");
+  EXPECT_EQ(tally.same_points.ToString(), "0 / 0 / 0");
+  table.str("");
+  PrintRigidComparison(three, table);
+  EXPECT_NE(table.str().find("own RMSE 2 / 0 / 1 (sign test p = 1.000); common frames 2 / 0 / 1"),
+            std::string::npos)
+      << table.str();
   std::filesystem::remove_all(folder);
 }
 

@@ -205,7 +205,8 @@ std::string RigidSection(const std::vector<RigidComparison>& comparisons) {
           "of a deforming scene as outliers and is otherwise scored on the points that still fit).</p>";
   std::vector<std::vector<std::string>> rows;
   for (const RigidComparison& comparison : comparisons) rows.push_back(RigidComparisonCells(comparison));
-  html << HtmlTable(RigidComparisonHeader(), rows) << "</section>\n";
+  html << HtmlTable(RigidComparisonHeader(), rows) << "<p>"
+       << EscapeXml(RigidComparisonTallyText(TallyRigidComparisons(comparisons))) << "</p></section>\n";
   return html.str();
 }
 

@@ -84,6 +84,24 @@ std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const 
   return comparisons;
 }
 
+RigidComparisonTally TallyRigidComparisons(const std::vector<RigidComparison>& comparisons) {
+  RigidComparisonTally tally;
+  for (const RigidComparison& c : comparisons) {
+    tally.own.Add(c.rigid.rmse_mm, c.deformable.rmse_mm);
+    if (c.common.frames > 0) tally.common.Add(c.common.b_mm, c.common.a_mm);
+    if (c.same_points.frames > 0) tally.same_points.Add(c.same_points.b_common.rmse_mm, c.same_points.a_common.rmse_mm);
+  }
+  return tally;
+}
+
+std::string RigidComparisonTallyText(const RigidComparisonTally& tally) {
+  const auto count = [](const RmseChangeCounts& counts) {
+    return counts.ToString() + " (sign test p = " + FormatFixed(counts.SignTestP(), 3) + ")";
+  };
+  return "Deformable better / same / worse than rigid: own RMSE " + count(tally.own) + "; common frames " +
+         count(tally.common) + "; same points " + count(tally.same_points) + ".";
+}
+
 std::vector<std::string> RigidComparisonHeader() {
   return {"deformable run", "rigid run",     "def mm",        "rigid mm",        "ratio",
           "tracked def / rigid", "common frames", "def mm common", "rigid mm common", "ratio common",
@@ -119,6 +137,7 @@ void PrintRigidComparison(const std::vector<RigidComparison>& comparisons, std::
   TextTable table(RigidComparisonHeader());
   for (const RigidComparison& c : comparisons) table.AddRow(RigidComparisonCells(c));
   table.Print(out);
+  out << RigidComparisonTallyText(TallyRigidComparisons(comparisons)) << '\n';
 }
 
 void WriteRigidComparison(const std::vector<RigidComparison>& comparisons, const std::filesystem::path& file) {

@@ -40,12 +40,23 @@ struct RigidComparison {
 // evaluated against ground truth. `results` is CollectResults(plan): one per run, in order.
 std::vector<RigidComparison> CompareWithRigid(const EvaluationPlan& plan, const std::vector<RunResult>& results);
 
+// Over all pairs, how often the deformable run is the more accurate ("better": its RMSE below
+// its rigid partner's, "same" to the printed 0.001 mm): by each run's own RMSE, over the common
+// frames, and on the same points. A pair without common frames (or points) is left out of that
+// count. Single runs are chaotic, so over many renderings these counts say more than any one row.
+struct RigidComparisonTally {
+  RmseChangeCounts own, common, same_points;
+};
+RigidComparisonTally TallyRigidComparisons(const std::vector<RigidComparison>& comparisons);
+// One line: each count with its sign test.
+std::string RigidComparisonTallyText(const RigidComparisonTally& tally);
+
 // The columns as the text table, the CSV file and the HTML report show them, and one pair's
 // cells. The ratio is rigid / deformable: above 1, the deformable run is the more accurate.
 std::vector<std::string> RigidComparisonHeader();
 std::vector<std::string> RigidComparisonCells(const RigidComparison& comparison);
 
-// A titled text table; nothing when there are no pairs.
+// A titled text table and the tally; nothing when there are no pairs.
 void PrintRigidComparison(const std::vector<RigidComparison>& comparisons, std::ostream& out);
 // `file` as CSV (header only when there are no pairs).
 void WriteRigidComparison(const std::vector<RigidComparison>& comparisons, const std::filesystem::path& file);
