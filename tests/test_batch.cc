@@ -17,6 +17,7 @@
 #include "nrslam/batch/results.h"
 #include "nrslam/batch/results_diff.h"
 #include "nrslam/batch/rigid_comparison.h"
+#include "nrslam/batch/seed_groups.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
 #include "temp_folder.h"
@@ -482,6 +483,76 @@ TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
+  const auto folder = UniqueTempFolder("seed_groups");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
+      {"name": "a1", "preset": "sim-3", "simulate": {"seed": 1}},
+      {"name": "a2", "preset": "sim-3", "simulate": {"seed": 2}},
+      {"name": "a3", "preset": "sim-3", "simulate": {"seed": 3}},
+      {"name": "a1-rigid", "preset": "sim-3", "simulate": {"seed": 1}, "rigid": true},
+      {"name": "a2-rigid", "preset": "sim-3", "simulate": {"seed": 2}, "rigid": true},
+      {"name": "small1", "preset": "sim-3", "simulate": {"seed": 1, "camera.width": 320}},
+      {"name": "small2", "preset": "sim-3", "simulate": {"seed": 2, "camera.width": 320}},
+      {"name": "k2", "preset": "sim-3", "simulate": {"seed": 3}, "set": {"k": 2}},
+      {"name": "alone", "preset": "sim-4", "simulate": {"seed": 1}}
+    ]})"));
+  const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  ASSERT_EQ(plan.runs.size(), 9u);
+  std::vector<RunResult> results;
+  const std::vector<std::vector<double>> frames = {{1.0, 3.0}, {4.0, 4.0}, {9.0, 9.0}, {1.0, 1.0}, {1.0, 1.0},
+                                                   {0.5, 0.5}, {0.7, 0.7}, {5.0, 5.0}, {6.0, 6.0}};
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    results.push_back(FinishedRun(plan.runs[i], frames[i]));
+    results.back().ate_mm = 0.1 * static_cast<double>(i + 1);
+  }
+  results[2].status = "lost";  // a3 lost the track: left out of its group's figures, counted
+  results[6].ate_mm = -1;      // small2 without a trajectory error
+
+  const std::vector<SeedGroup> groups = GroupBySeed(plan, results);
+  // k2 differs from a3 in an option and "alone" has no other seed: neither forms a group.
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_EQ(groups[0].name, "sim-3");
+  EXPECT_EQ(groups[0].sequences, (std::vector<std::string>{"a1", "a2", "a3"}));
+  EXPECT_EQ(groups[0].seeds, (std::vector<std::string>{"1", "2", "3"}));
+  EXPECT_EQ(groups[0].complete, 2);
+  EXPECT_DOUBLE_EQ(groups[0].mean_rmse_mm, 3.0);       // 2 and 4
+  EXPECT_DOUBLE_EQ(groups[0].sd_rmse_mm, std::sqrt(2.0));  // sample sd of {2, 4}
+  EXPECT_DOUBLE_EQ(groups[0].min_rmse_mm, 2.0);
+  EXPECT_DOUBLE_EQ(groups[0].max_rmse_mm, 4.0);
+  EXPECT_NEAR(groups[0].mean_ate_mm, 0.15, 1e-12);    // a1's 0.1 and a2's 0.2
+  EXPECT_EQ(groups[1].name, "sim-3 rigid");
+  EXPECT_EQ(groups[1].sequences, (std::vector<std::string>{"a1-rigid", "a2-rigid"}));
+  EXPECT_DOUBLE_EQ(groups[1].sd_rmse_mm, 0.0);
+  EXPECT_EQ(groups[2].name, "sim-3 camera.width=320");
+  EXPECT_DOUBLE_EQ(groups[2].mean_rmse_mm, 0.6);
+  EXPECT_LT(groups[2].mean_ate_mm, 0.0);  // one complete member has none
+
+  const std::vector<std::string> cells = SeedGroupCells(groups[0]);
+  ASSERT_EQ(cells.size(), SeedGroupHeader().size());
+  EXPECT_EQ(cells[1], "1 2 3");
+  EXPECT_EQ(cells[2], "2/3");
+  EXPECT_EQ(cells[3], "3.000");
+  EXPECT_EQ(cells[4], "1.414");
+  EXPECT_EQ(SeedGroupCells(groups[2])[8], "-");
+  std::stringstream table;
+  PrintSeedGroups(groups, table);
+  EXPECT_NE(table.str().find("sim-3 rigid"), std::string::npos) << table.str();
+  table.str("");
+  PrintSeedGroups({}, table);
+  EXPECT_TRUE(table.str().empty());
+
+  // A sweep keeps its points apart: one group per value.
+  const EvaluationPlan swept = PlanEvaluation(manifest, {}, {ParseSweep("k=0.5,2")}, folder / "swept", folder / "cache");
+  std::vector<RunResult> swept_results;
+  for (const RunJob& run : swept.runs) swept_results.push_back(FinishedRun(run, {1.0}));
+  const std::vector<SeedGroup> per_value = GroupBySeed(swept, swept_results);
+  // Three groups per value: the sweep sets k after k2's own, so k2 joins a1 … a3 at both.
+  ASSERT_EQ(per_value.size(), 6u);
+  EXPECT_EQ(per_value[0].name, "sim-3 [k=0.5]");
+  EXPECT_EQ(per_value[1].name, "sim-3 [k=2]");
+  EXPECT_EQ(per_value[1].sequences, (std::vector<std::string>{"a1", "a2", "a3", "k2"}));
+}
+
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   const auto folder = UniqueTempFolder("batch_broken");
   // A sequence folder with an incomplete sequence.json, between two good simulated ones (eight
@@ -537,7 +608,7 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
 
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,
   // and the failed sequence is shown as such.
-  WriteReport(results, comparisons, folder / "out" / "report");
+  WriteReport(results, comparisons, GroupBySeed(plan, results), folder / "out" / "report");
   if (std::system("chromium --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "chromium is not installed";
   const std::string dom = (folder / "dom.html").string(), log = (folder / "browser.log").string();
   ASSERT_EQ(std::system(("timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=5000 "

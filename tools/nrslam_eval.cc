@@ -1,11 +1,12 @@
 // nrslam_eval: runs NR-SLAM over every sequence of a manifest (each in its own process),
 // with optional parameter sweeps, prints the results table (and each deformable run beside
-// its rigid baseline, when the manifest has both), writes results.json/.csv, and checks or
-// writes a regression baseline. `nrslam_eval merge DIR... --out DIR` aggregates
-// result folders (e.g. of jobs emitted with --emit-jobs and run elsewhere); `nrslam_eval
-// compare RUN_A RUN_B` scores two runs of one sequence on the points both report; `nrslam_eval
-// diff EVAL_A EVAL_B` sets two evaluations of the same runs side by side, run for run;
-// `nrslam_eval score SEQUENCE ESTIMATES --out DIR` scores another system's output as a run.
+// its rigid baseline, when the manifest has both, and each preset over its scene seeds),
+// writes results.json/.csv, and checks or writes a regression baseline. `nrslam_eval merge
+// DIR... --out DIR` aggregates result folders (e.g. of jobs emitted with --emit-jobs and run
+// elsewhere); `nrslam_eval compare RUN_A RUN_B` scores two runs of one sequence on the points
+// both report; `nrslam_eval diff EVAL_A EVAL_B` sets two evaluations of the same runs side by
+// side, run for run; `nrslam_eval score SEQUENCE ESTIMATES --out DIR` scores another system's
+// output as a run.
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -19,6 +20,7 @@
 #include "nrslam/batch/results_diff.h"
 #include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/batch/run_folder.h"
+#include "nrslam/batch/seed_groups.h"
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
@@ -41,10 +43,12 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   const std::vector<nrslam::RigidComparison> comparisons = nrslam::CompareWithRigid(plan, results);
   nrslam::WriteResults(results, out);
   nrslam::WriteRigidComparison(comparisons, out / "rigid_comparison.csv");
-  nrslam::WriteReport(results, comparisons, out / "report");
+  const std::vector<nrslam::SeedGroup> seed_groups = nrslam::GroupBySeed(plan, results);
+  nrslam::WriteReport(results, comparisons, seed_groups, out / "report");
   std::cout << '\n';
   nrslam::PrintResults(results, std::cout);
   nrslam::PrintRigidComparison(comparisons, std::cout);
+  nrslam::PrintSeedGroups(seed_groups, std::cout);
   std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string()
             << (comparisons.empty() ? "" : ", " + (out / "rigid_comparison.csv").string())
             << "\nreport:  " << (out / "report" / "index.html").string() << '\n';

@@ -210,10 +210,20 @@ std::string RigidSection(const std::vector<RigidComparison>& comparisons) {
   return html.str();
 }
 
+std::string SeedSection(const std::vector<SeedGroup>& groups) {
+  if (groups.empty()) return "";
+  std::vector<std::vector<std::string>> rows;
+  for (const SeedGroup& group : groups) rows.push_back(SeedGroupCells(group));
+  return "<section><h2>Over scene seeds</h2><p>Runs of one preset that differ only in the simulator's seed. "
+         "RMSE over the runs tracked to the end (\"to end\"); sd is the sample standard deviation across "
+         "seeds.</p>" +
+         HtmlTable(SeedGroupHeader(), rows) + "</section>\n";
+}
+
 }  // namespace
 
 void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidComparison>& comparisons,
-                 const std::filesystem::path& folder) {
+                 const std::vector<SeedGroup>& seed_groups, const std::filesystem::path& folder) {
   std::filesystem::create_directories(folder);
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>nrslam evaluation</title>\n"
@@ -235,7 +245,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
          << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FlatRmseCell(r) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
-  html << "</table>\n" << SweepSection(results) << RigidSection(comparisons);
+  html << "</table>\n" << SweepSection(results) << RigidSection(comparisons) << SeedSection(seed_groups);
   for (const RunResult& r : results) html << RunSection(r, folder);
   // Self-check for people and for the test that opens the page in a headless browser.
   html << "<script>window.addEventListener('load',()=>{const i=[...document.images];"

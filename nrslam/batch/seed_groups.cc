@@ -1,0 +1,134 @@
+#include "nrslam/batch/seed_groups.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "nrslam/util/error.h"
+#include "nrslam/util/median.h"
+#include "nrslam/util/text_table.h"
+
+namespace nrslam {
+namespace {
+
+constexpr char kSeedAssignment[] = "seed=";
+
+bool IsSeedAssignment(const std::string& argument) { return argument.rfind(kSeedAssignment, 0) == 0; }
+
+// The render arguments without the seed: {"--preset", "sim-3", "--quiet", "--set", "seed=2"}
+// gives {"--preset", "sim-3", "--quiet"}.
+std::vector<std::string> WithoutSeed(const std::vector<std::string>& arguments) {
+  std::vector<std::string> kept;
+  for (size_t i = 0; i < arguments.size(); ++i) {
+    if (arguments[i] == "--set" && i + 1 < arguments.size() && IsSeedAssignment(arguments[i + 1])) {
+      ++i;
+      continue;
+    }
+    kept.push_back(arguments[i]);
+  }
+  return kept;
+}
+
+std::string SeedOf(const std::vector<std::string>& arguments) {
+  for (const std::string& argument : arguments) {
+    if (IsSeedAssignment(argument)) return argument.substr(sizeof(kSeedAssignment) - 1);
+  }
+  return "default";
+}
+
+std::string GroupName(const PrepareJob& render, const RunJob& run) {
+  std::string name;
+  const std::vector<std::string> arguments = WithoutSeed(render.arguments);
+  for (size_t i = 0; i < arguments.size(); ++i) {
+    if (arguments[i] == "--preset" && i + 1 < arguments.size()) name = arguments[i + 1] + name;
+    if (arguments[i] == "--set" && i + 1 < arguments.size()) name += " " + arguments[i + 1];
+  }
+  if (run.options.at("tracking").at("rigid").get<bool>()) name += " rigid";
+  if (!run.label.empty()) name += " [" + run.label + "]";
+  return name;
+}
+
+void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
+  std::vector<double> rmse;
+  bool every_ate = true;
+  double ate_sum = 0;
+  for (const RunResult* result : members) {
+    if (!result->complete()) continue;
+    rmse.push_back(result->rmse_mm);
+    every_ate = every_ate && result->ate_mm >= 0;
+    ate_sum += result->ate_mm;
+  }
+  group->complete = static_cast<int>(rmse.size());
+  if (rmse.empty()) return;
+  group->mean_rmse_mm = Mean(rmse);
+  double squares = 0;
+  for (double value : rmse) squares += (value - group->mean_rmse_mm) * (value - group->mean_rmse_mm);
+  group->sd_rmse_mm = rmse.size() > 1 ? std::sqrt(squares / (rmse.size() - 1)) : 0.0;
+  group->median_rmse_mm = Median(rmse);
+  group->min_rmse_mm = *std::min_element(rmse.begin(), rmse.end());
+  group->max_rmse_mm = *std::max_element(rmse.begin(), rmse.end());
+  group->mean_ate_mm = every_ate ? ate_sum / rmse.size() : -1;
+}
+
+}  // namespace
+
+std::vector<SeedGroup> GroupBySeed(const EvaluationPlan& plan, const std::vector<RunResult>& results) {
+  if (results.size() != plan.runs.size()) throw Error("seed groups: results do not match the plan's runs");
+  std::map<std::string, size_t> index_of_key;
+  std::vector<SeedGroup> groups;
+  std::vector<std::vector<const RunResult*>> members;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    const RunJob& run = plan.runs[i];
+    if (run.is_external() || run.prepare < 0 || plan.prepares[run.prepare].import) continue;
+    const PrepareJob& render = plan.prepares[run.prepare];
+    std::string key;
+    for (const std::string& argument : WithoutSeed(render.arguments)) key += argument + '\n';
+    key += run.options.dump();
+    const auto [found, added] = index_of_key.emplace(key, groups.size());
+    if (added) {
+      groups.push_back({GroupName(render, run), {}, {}});
+      members.emplace_back();
+    }
+    groups[found->second].sequences.push_back(run.sequence);
+    groups[found->second].seeds.push_back(SeedOf(render.arguments));
+    members[found->second].push_back(&results[i]);
+  }
+  std::vector<SeedGroup> summarised;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    if (groups[g].sequences.size() < 2) continue;
+    Summarise(members[g], &groups[g]);
+    summarised.push_back(groups[g]);
+  }
+  return summarised;
+}
+
+std::vector<std::string> SeedGroupHeader() {
+  return {"preset", "seeds", "to end", "mean RMSE mm", "sd mm", "median mm", "min mm", "max mm", "mean ATE mm"};
+}
+
+std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
+  std::string seeds;
+  for (const std::string& seed : group.seeds) seeds += (seeds.empty() ? "" : " ") + seed;
+  const bool any = group.complete > 0;
+  const auto mm = [any](double value) { return any ? FormatFixed(value, 3) : "-"; };
+  return {group.name,
+          seeds,
+          std::to_string(group.complete) + "/" + std::to_string(group.seeds.size()),
+          mm(group.mean_rmse_mm),
+          group.complete > 1 ? FormatFixed(group.sd_rmse_mm, 3) : "-",
+          mm(group.median_rmse_mm),
+          mm(group.min_rmse_mm),
+          mm(group.max_rmse_mm),
+          any ? AteCell(group.mean_ate_mm) : "-"};
+}
+
+void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
+  if (groups.empty()) return;
+  out << "\nOver scene seeds: runs of one preset that differ only in the simulator's seed. RMSE over the runs\n"
+         "tracked to the end (\"to end\"); sd is the sample standard deviation across seeds.\n";
+  TextTable table(SeedGroupHeader());
+  for (const SeedGroup& group : groups) table.AddRow(SeedGroupCells(group));
+  table.Print(out);
+}
+
+}  // namespace nrslam

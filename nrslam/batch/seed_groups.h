@@ -1,0 +1,39 @@
+// batch: runs that differ only in the simulator's scene seed, summarised together. Single
+// runs are chaotic (README "Mapping"), so a preset is best judged over several renderings of
+// it (e.g. colon-seeds-monocular.json: seeds 1–3 of each colon preset); this gives, per
+// preset, mode and sweep point, the mean and spread of the RMSE over its seeds.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/results.h"
+
+namespace nrslam {
+
+struct SeedGroup {
+  // The preset, any other simulator settings, "rigid" for a rigid group and the sweep point:
+  // "sim-3", "sim-3 camera.width=320 rigid [k=2]".
+  std::string name;
+  std::vector<std::string> sequences;  // manifest names of the members, in manifest order
+  std::vector<std::string> seeds;      // their scene seeds, as the manifest gives them
+  // Over the members tracked to the end with ground truth (RunResult::complete), so a seed
+  // that loses the track does not pull the mean toward its easy first frames.
+  int complete = 0;
+  double mean_rmse_mm = 0, sd_rmse_mm = 0, median_rmse_mm = 0, min_rmse_mm = 0, max_rmse_mm = 0;
+  double mean_ate_mm = -1;  // negative: a complete member has no trajectory error
+};
+
+// Groups the runs of rendered presets whose render settings other than the seed and whose
+// run options are all equal, in the order of each group's first run. Only groups of two or
+// more runs are returned. `results` is CollectResults(plan): one per run, in order.
+std::vector<SeedGroup> GroupBySeed(const EvaluationPlan& plan, const std::vector<RunResult>& results);
+
+std::vector<std::string> SeedGroupHeader();
+std::vector<std::string> SeedGroupCells(const SeedGroup& group);
+// Prints nothing without groups.
+void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out);
+
+}  // namespace nrslam
