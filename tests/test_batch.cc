@@ -17,6 +17,7 @@
 #include "nrslam/batch/results.h"
 #include "nrslam/batch/results_diff.h"
 #include "nrslam/batch/rigid_comparison.h"
+#include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/seed_groups.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
@@ -540,6 +541,12 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
   table.str("");
   PrintSeedGroups({}, table);
   EXPECT_TRUE(table.str().empty());
+  WriteSeedGroups(groups, folder / "seed_groups.csv");
+  const auto rows = ReadCsv(folder / "seed_groups.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].at("sequences"), "a1 a2 a3");
+  EXPECT_NEAR(Number(rows[0], "sd_rmse_mm"), std::sqrt(2.0), 1e-5);  // six significant digits, as every CSV
+  EXPECT_TRUE(std::isnan(Number(rows[2], "mean_ate_mm")));
 
   // A sweep keeps its points apart: one group per value.
   const EvaluationPlan swept = PlanEvaluation(manifest, {}, {ParseSweep("k=0.5,2")}, folder / "swept", folder / "cache");

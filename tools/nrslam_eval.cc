@@ -44,6 +44,7 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   nrslam::WriteResults(results, out);
   nrslam::WriteRigidComparison(comparisons, out / "rigid_comparison.csv");
   const std::vector<nrslam::SeedGroup> seed_groups = nrslam::GroupBySeed(plan, results);
+  if (!seed_groups.empty()) nrslam::WriteSeedGroups(seed_groups, out / "seed_groups.csv");
   nrslam::WriteReport(results, comparisons, seed_groups, out / "report");
   std::cout << '\n';
   nrslam::PrintResults(results, std::cout);
@@ -51,6 +52,7 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   nrslam::PrintSeedGroups(seed_groups, std::cout);
   std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string()
             << (comparisons.empty() ? "" : ", " + (out / "rigid_comparison.csv").string())
+            << (seed_groups.empty() ? "" : ", " + (out / "seed_groups.csv").string())
             << "\nreport:  " << (out / "report" / "index.html").string() << '\n';
   int code = 0;
   for (const auto& result : results) code = result.status == "failed" ? 2 : code;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
 
 #include "nrslam/util/error.h"
@@ -70,6 +71,12 @@ void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
   group->mean_ate_mm = every_ate ? ate_sum / rmse.size() : -1;
 }
 
+std::string Joined(const std::vector<std::string>& words) {
+  std::string text;
+  for (const std::string& word : words) text += (text.empty() ? "" : " ") + word;
+  return text;
+}
+
 }  // namespace
 
 std::vector<SeedGroup> GroupBySeed(const EvaluationPlan& plan, const std::vector<RunResult>& results) {
@@ -107,8 +114,7 @@ std::vector<std::string> SeedGroupHeader() {
 }
 
 std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
-  std::string seeds;
-  for (const std::string& seed : group.seeds) seeds += (seeds.empty() ? "" : " ") + seed;
+  const std::string seeds = Joined(group.seeds);
   const bool any = group.complete > 0;
   const auto mm = [any](double value) { return any ? FormatFixed(value, 3) : "-"; };
   return {group.name,
@@ -129,6 +135,26 @@ void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
   TextTable table(SeedGroupHeader());
   for (const SeedGroup& group : groups) table.AddRow(SeedGroupCells(group));
   table.Print(out);
+}
+
+void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem::path& file) {
+  std::ofstream csv(file);
+  csv << "preset,seeds,sequences,runs,complete,mean_rmse_mm,sd_rmse_mm,median_rmse_mm,min_rmse_mm,max_rmse_mm,"
+         "mean_ate_mm\n";
+  for (const SeedGroup& group : groups) {
+    csv << CsvField(group.name) << ',' << Joined(group.seeds) << ',' << Joined(group.sequences) << ','
+        << group.seeds.size() << ',' << group.complete;
+    if (group.complete > 0) {
+      csv << ',' << group.mean_rmse_mm << ',';
+      if (group.complete > 1) csv << group.sd_rmse_mm;
+      csv << ',' << group.median_rmse_mm << ','
+          << group.min_rmse_mm << ',' << group.max_rmse_mm << ',';
+      if (group.mean_ate_mm >= 0) csv << group.mean_ate_mm;
+    } else {
+      csv << ",,,,,,";
+    }
+    csv << '\n';
+  }
 }
 
 }  // namespace nrslam

@@ -4,6 +4,7 @@
 // preset, mode and sweep point, the mean and spread of the RMSE over its seeds.
 #pragma once
 
+#include <filesystem>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -35,5 +36,8 @@ std::vector<std::string> SeedGroupHeader();
 std::vector<std::string> SeedGroupCells(const SeedGroup& group);
 // Prints nothing without groups.
 void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out);
+// The groups as CSV, one row each (members separated by spaces; empty fields where no member
+// was tracked to the end, and no sd from a single one).
+void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem::path& file);
 
 }  // namespace nrslam
