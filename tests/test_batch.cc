@@ -490,6 +490,7 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
       {"name": "a1", "preset": "sim-3", "simulate": {"seed": 1}},
       {"name": "a2", "preset": "sim-3", "simulate": {"seed": 2}},
       {"name": "a3", "preset": "sim-3", "simulate": {"seed": 3}},
+      {"name": "a4", "preset": "sim-3", "simulate": {"seed": 4}},
       {"name": "a1-rigid", "preset": "sim-3", "simulate": {"seed": 1}, "rigid": true},
       {"name": "a2-rigid", "preset": "sim-3", "simulate": {"seed": 2}, "rigid": true},
       {"name": "small1", "preset": "sim-3", "simulate": {"seed": 1, "camera.width": 320}},
@@ -498,43 +499,47 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
       {"name": "alone", "preset": "sim-4", "simulate": {"seed": 1}}
     ]})"));
   const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
-  ASSERT_EQ(plan.runs.size(), 9u);
+  ASSERT_EQ(plan.runs.size(), 10u);
   std::vector<RunResult> results;
-  const std::vector<std::vector<double>> frames = {{1.0, 3.0}, {4.0, 4.0}, {9.0, 9.0}, {1.0, 1.0}, {1.0, 1.0},
-                                                   {0.5, 0.5}, {0.7, 0.7}, {5.0, 5.0}, {6.0, 6.0}};
+  const std::vector<std::vector<double>> frames = {{1.0, 3.0}, {4.0, 4.0}, {9.0, 9.0}, {7.0, 7.0}, {1.0, 1.0},
+                                                   {1.0, 1.0}, {0.5, 0.5}, {0.7, 0.7}, {5.0, 5.0}, {6.0, 6.0}};
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     results.push_back(FinishedRun(plan.runs[i], frames[i]));
     results.back().ate_mm = 0.1 * static_cast<double>(i + 1);
   }
-  results[2].status = "lost";  // a3 lost the track: left out of its group's figures, counted
-  results[6].ate_mm = -1;      // small2 without a trajectory error
+  results[2].status = "lost";    // a3 lost the track: scored on its own frames, not "to end"
+  results[3].status = "failed";  // a4 failed: not scored
+  results[7].ate_mm = -1;        // small2 without a trajectory error
 
   const std::vector<SeedGroup> groups = GroupBySeed(plan, results);
   // k2 differs from a3 in an option and "alone" has no other seed: neither forms a group.
   ASSERT_EQ(groups.size(), 3u);
   EXPECT_EQ(groups[0].name, "sim-3");
-  EXPECT_EQ(groups[0].sequences, (std::vector<std::string>{"a1", "a2", "a3"}));
-  EXPECT_EQ(groups[0].seeds, (std::vector<std::string>{"1", "2", "3"}));
-  EXPECT_EQ(groups[0].complete, 2);
-  EXPECT_DOUBLE_EQ(groups[0].mean_rmse_mm, 3.0);       // 2 and 4
-  EXPECT_DOUBLE_EQ(groups[0].sd_rmse_mm, std::sqrt(2.0));  // sample sd of {2, 4}
+  EXPECT_EQ(groups[0].sequences, (std::vector<std::string>{"a1", "a2", "a3", "a4"}));
+  EXPECT_EQ(groups[0].seeds, (std::vector<std::string>{"1", "2", "3", "4"}));
+  EXPECT_EQ(groups[0].scored, 3);
+  EXPECT_EQ(groups[0].to_end, 2);
+  EXPECT_DOUBLE_EQ(groups[0].mean_rmse_mm, 5.0);            // 2, 4 and 9
+  EXPECT_DOUBLE_EQ(groups[0].sd_rmse_mm, std::sqrt(13.0));  // sample sd of {2, 4, 9}
+  EXPECT_DOUBLE_EQ(groups[0].median_rmse_mm, 4.0);
   EXPECT_DOUBLE_EQ(groups[0].min_rmse_mm, 2.0);
-  EXPECT_DOUBLE_EQ(groups[0].max_rmse_mm, 4.0);
-  EXPECT_NEAR(groups[0].mean_ate_mm, 0.15, 1e-12);    // a1's 0.1 and a2's 0.2
+  EXPECT_DOUBLE_EQ(groups[0].max_rmse_mm, 9.0);
+  EXPECT_NEAR(groups[0].mean_ate_mm, 0.2, 1e-12);           // 0.1, 0.2 and 0.3
   EXPECT_EQ(groups[1].name, "sim-3 rigid");
   EXPECT_EQ(groups[1].sequences, (std::vector<std::string>{"a1-rigid", "a2-rigid"}));
   EXPECT_DOUBLE_EQ(groups[1].sd_rmse_mm, 0.0);
   EXPECT_EQ(groups[2].name, "sim-3 camera.width=320");
   EXPECT_DOUBLE_EQ(groups[2].mean_rmse_mm, 0.6);
-  EXPECT_LT(groups[2].mean_ate_mm, 0.0);  // one complete member has none
+  EXPECT_LT(groups[2].mean_ate_mm, 0.0);  // one scored member has none
 
   const std::vector<std::string> cells = SeedGroupCells(groups[0]);
   ASSERT_EQ(cells.size(), SeedGroupHeader().size());
-  EXPECT_EQ(cells[1], "1 2 3");
-  EXPECT_EQ(cells[2], "2/3");
-  EXPECT_EQ(cells[3], "3.000");
-  EXPECT_EQ(cells[4], "1.414");
-  EXPECT_EQ(SeedGroupCells(groups[2])[8], "-");
+  EXPECT_EQ(cells[1], "1 2 3 4");
+  EXPECT_EQ(cells[2], "3/4");
+  EXPECT_EQ(cells[3], "2");
+  EXPECT_EQ(cells[4], "5.000");
+  EXPECT_EQ(cells[5], "3.606");
+  EXPECT_EQ(SeedGroupCells(groups[2])[9], "-");
   std::stringstream table;
   PrintSeedGroups(groups, table);
   EXPECT_NE(table.str().find("sim-3 rigid"), std::string::npos) << table.str();
@@ -544,20 +549,25 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
   WriteSeedGroups(groups, folder / "seed_groups.csv");
   const auto rows = ReadCsv(folder / "seed_groups.csv");
   ASSERT_EQ(rows.size(), 3u);
-  EXPECT_EQ(rows[0].at("sequences"), "a1 a2 a3");
-  EXPECT_NEAR(Number(rows[0], "sd_rmse_mm"), std::sqrt(2.0), 1e-5);  // six significant digits, as every CSV
+  EXPECT_EQ(rows[0].at("sequences"), "a1 a2 a3 a4");
+  EXPECT_NEAR(Number(rows[0], "sd_rmse_mm"), std::sqrt(13.0), 1e-5);  // six significant digits, as every CSV
   EXPECT_TRUE(std::isnan(Number(rows[2], "mean_ate_mm")));
 
-  // A sweep keeps its points apart: one group per value.
+  // A sweep keeps its points apart: one group per value. Sweeping the rigid flag names it once.
   const EvaluationPlan swept = PlanEvaluation(manifest, {}, {ParseSweep("k=0.5,2")}, folder / "swept", folder / "cache");
   std::vector<RunResult> swept_results;
   for (const RunJob& run : swept.runs) swept_results.push_back(FinishedRun(run, {1.0}));
   const std::vector<SeedGroup> per_value = GroupBySeed(swept, swept_results);
-  // Three groups per value: the sweep sets k after k2's own, so k2 joins a1 … a3 at both.
+  // Three groups per value: the sweep sets k after k2's own, so k2 joins a1 … a4 at both.
   ASSERT_EQ(per_value.size(), 6u);
   EXPECT_EQ(per_value[0].name, "sim-3 [k=0.5]");
   EXPECT_EQ(per_value[1].name, "sim-3 [k=2]");
-  EXPECT_EQ(per_value[1].sequences, (std::vector<std::string>{"a1", "a2", "a3", "k2"}));
+  EXPECT_EQ(per_value[1].sequences, (std::vector<std::string>{"a1", "a2", "a3", "a4", "k2"}));
+  const EvaluationPlan rigidity =
+      PlanEvaluation(manifest, {}, {ParseSweep("tracking.rigid=false,true")}, folder / "rigidity", folder / "cache");
+  std::vector<RunResult> rigidity_results;
+  for (const RunJob& run : rigidity.runs) rigidity_results.push_back(FinishedRun(run, {1.0}));
+  EXPECT_EQ(GroupBySeed(rigidity, rigidity_results)[1].name, "sim-3 [rigid=true]");
 }
 
 TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {

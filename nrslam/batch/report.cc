@@ -215,8 +215,8 @@ std::string SeedSection(const std::vector<SeedGroup>& groups) {
   std::vector<std::vector<std::string>> rows;
   for (const SeedGroup& group : groups) rows.push_back(SeedGroupCells(group));
   return "<section><h2>Over scene seeds</h2><p>Runs of one preset that differ only in the simulator's seed. "
-         "RMSE over the runs tracked to the end (\"to end\"); sd is the sample standard deviation across "
-         "seeds.</p>" +
+         "Each is scored by its own RMSE (\"to end\": how many of those tracked every frame); sd is the sample "
+         "standard deviation across seeds.</p>" +
          HtmlTable(SeedGroupHeader(), rows) + "</section>\n";
 }
 

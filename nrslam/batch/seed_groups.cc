@@ -44,7 +44,10 @@ std::string GroupName(const PrepareJob& render, const RunJob& run) {
     if (arguments[i] == "--preset" && i + 1 < arguments.size()) name = arguments[i + 1] + name;
     if (arguments[i] == "--set" && i + 1 < arguments.size()) name += " " + arguments[i + 1];
   }
-  if (run.options.at("tracking").at("rigid").get<bool>()) name += " rigid";
+  const bool swept_rigidity = std::any_of(run.point.begin(), run.point.end(), [](const std::string& assignment) {
+    return assignment.rfind("tracking.rigid=", 0) == 0;
+  });
+  if (run.options.at("tracking").at("rigid").get<bool>() && !swept_rigidity) name += " rigid";
   if (!run.label.empty()) name += " [" + run.label + "]";
   return name;
 }
@@ -54,12 +57,13 @@ void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
   bool every_ate = true;
   double ate_sum = 0;
   for (const RunResult* result : members) {
-    if (!result->complete()) continue;
+    if (result->status == "failed" || !result->evaluated()) continue;
+    if (result->complete()) ++group->to_end;
     rmse.push_back(result->rmse_mm);
     every_ate = every_ate && result->ate_mm >= 0;
     ate_sum += result->ate_mm;
   }
-  group->complete = static_cast<int>(rmse.size());
+  group->scored = static_cast<int>(rmse.size());
   if (rmse.empty()) return;
   group->mean_rmse_mm = Mean(rmse);
   double squares = 0;
@@ -110,18 +114,19 @@ std::vector<SeedGroup> GroupBySeed(const EvaluationPlan& plan, const std::vector
 }
 
 std::vector<std::string> SeedGroupHeader() {
-  return {"preset", "seeds", "to end", "mean RMSE mm", "sd mm", "median mm", "min mm", "max mm", "mean ATE mm"};
+  return {"preset", "seeds", "scored", "to end", "mean RMSE mm", "sd mm", "median mm", "min mm", "max mm", "mean ATE mm"};
 }
 
 std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
   const std::string seeds = Joined(group.seeds);
-  const bool any = group.complete > 0;
+  const bool any = group.scored > 0;
   const auto mm = [any](double value) { return any ? FormatFixed(value, 3) : "-"; };
   return {group.name,
           seeds,
-          std::to_string(group.complete) + "/" + std::to_string(group.seeds.size()),
+          std::to_string(group.scored) + "/" + std::to_string(group.seeds.size()),
+          std::to_string(group.to_end),
           mm(group.mean_rmse_mm),
-          group.complete > 1 ? FormatFixed(group.sd_rmse_mm, 3) : "-",
+          group.scored > 1 ? FormatFixed(group.sd_rmse_mm, 3) : "-",
           mm(group.median_rmse_mm),
           mm(group.min_rmse_mm),
           mm(group.max_rmse_mm),
@@ -130,8 +135,8 @@ std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
 
 void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
   if (groups.empty()) return;
-  out << "\nOver scene seeds: runs of one preset that differ only in the simulator's seed. RMSE over the runs\n"
-         "tracked to the end (\"to end\"); sd is the sample standard deviation across seeds.\n";
+  out << "\nOver scene seeds: runs of one preset that differ only in the simulator's seed, each scored by its own\n"
+         "RMSE (\"to end\": how many of those tracked every frame); sd is the sample standard deviation across seeds.\n";
   TextTable table(SeedGroupHeader());
   for (const SeedGroup& group : groups) table.AddRow(SeedGroupCells(group));
   table.Print(out);
@@ -139,14 +144,14 @@ void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
 
 void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem::path& file) {
   std::ofstream csv(file);
-  csv << "preset,seeds,sequences,runs,complete,mean_rmse_mm,sd_rmse_mm,median_rmse_mm,min_rmse_mm,max_rmse_mm,"
+  csv << "preset,seeds,sequences,runs,scored,to_end,mean_rmse_mm,sd_rmse_mm,median_rmse_mm,min_rmse_mm,max_rmse_mm,"
          "mean_ate_mm\n";
   for (const SeedGroup& group : groups) {
     csv << CsvField(group.name) << ',' << Joined(group.seeds) << ',' << Joined(group.sequences) << ','
-        << group.seeds.size() << ',' << group.complete;
-    if (group.complete > 0) {
+        << group.seeds.size() << ',' << group.scored << ',' << group.to_end;
+    if (group.scored > 0) {
       csv << ',' << group.mean_rmse_mm << ',';
-      if (group.complete > 1) csv << group.sd_rmse_mm;
+      if (group.scored > 1) csv << group.sd_rmse_mm;
       csv << ',' << group.median_rmse_mm << ','
           << group.min_rmse_mm << ',' << group.max_rmse_mm << ',';
       if (group.mean_ate_mm >= 0) csv << group.mean_ate_mm;

@@ -20,11 +20,12 @@ struct SeedGroup {
   std::string name;
   std::vector<std::string> sequences;  // manifest names of the members, in manifest order
   std::vector<std::string> seeds;      // their scene seeds, as the manifest gives them
-  // Over the members tracked to the end with ground truth (RunResult::complete), so a seed
-  // that loses the track does not pull the mean toward its easy first frames.
-  int complete = 0;
+  // Over the members scored against ground truth (not failed, some frame evaluated), each by
+  // its own RMSE over the frames it tracked, as the results table gives it. A run that loses
+  // the track is scored on fewer frames: `to_end` says how many were tracked to the end.
+  int scored = 0, to_end = 0;
   double mean_rmse_mm = 0, sd_rmse_mm = 0, median_rmse_mm = 0, min_rmse_mm = 0, max_rmse_mm = 0;
-  double mean_ate_mm = -1;  // negative: a complete member has no trajectory error
+  double mean_ate_mm = -1;  // negative: a scored member has no trajectory error
 };
 
 // Groups the runs of rendered presets whose render settings other than the seed and whose
@@ -37,7 +38,7 @@ std::vector<std::string> SeedGroupCells(const SeedGroup& group);
 // Prints nothing without groups.
 void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out);
 // The groups as CSV, one row each (members separated by spaces; empty fields where no member
-// was tracked to the end, and no sd from a single one).
+// was scored, and no sd from a single one).
 void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem::path& file);
 
 }  // namespace nrslam
