@@ -499,6 +499,22 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
       {"name": "alone", "preset": "sim-4", "simulate": {"seed": 1}}
     ]})"));
   const EvaluationPlan plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
+  {
+    // Two groups that differ in a manifest option of their own are told apart by name.
+    const Manifest two = LoadManifest(WriteFile(folder / "two.json", R"({"sequences": [
+        {"name": "p1", "preset": "sim-3", "simulate": {"seed": 1}},
+        {"name": "p2", "preset": "sim-3", "simulate": {"seed": 2}},
+        {"name": "q1", "preset": "sim-3", "simulate": {"seed": 1}, "set": {"k": 2}},
+        {"name": "q2", "preset": "sim-3", "simulate": {"seed": 2}, "set": {"k": 2}}
+      ]})"));
+    const EvaluationPlan two_plan = PlanEvaluation(two, {}, {}, folder / "two", folder / "cache");
+    std::vector<RunResult> two_results;
+    for (const RunJob& run : two_plan.runs) two_results.push_back(FinishedRun(run, {1.0}));
+    const std::vector<SeedGroup> named = GroupBySeed(two_plan, two_results);
+    ASSERT_EQ(named.size(), 2u);
+    EXPECT_EQ(named[0].name, "sim-3 (p1, ...)");
+    EXPECT_EQ(named[1].name, "sim-3 (q1, ...)");
+  }
   ASSERT_EQ(plan.runs.size(), 10u);
   std::vector<RunResult> results;
   const std::vector<std::vector<double>> frames = {{1.0, 3.0}, {4.0, 4.0}, {9.0, 9.0}, {7.0, 7.0}, {1.0, 1.0},

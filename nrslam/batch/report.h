@@ -1,8 +1,8 @@
 // batch: the HTML report of an evaluation — the results table, and per run its RMSE over
 // time, its trajectory against the ground truth (top view), and depth-error images of a few
 // frames; with sweeps, RMSE against each swept option; deformable runs beside their rigid
-// baselines; presets over their scene seeds. One folder, no scripts from the network: it opens offline and can be archived
-// with the results.
+// baselines; presets over their scene seeds. One folder, no scripts from the network: it
+// opens offline and can be archived with the results.
 #pragma once
 
 #include <filesystem>

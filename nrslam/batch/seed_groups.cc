@@ -105,10 +105,16 @@ std::vector<SeedGroup> GroupBySeed(const EvaluationPlan& plan, const std::vector
     members[found->second].push_back(&results[i]);
   }
   std::vector<SeedGroup> summarised;
+  std::map<std::string, int> name_count;
   for (size_t g = 0; g < groups.size(); ++g) {
     if (groups[g].sequences.size() < 2) continue;
     Summarise(members[g], &groups[g]);
     summarised.push_back(groups[g]);
+    ++name_count[groups[g].name];
+  }
+  // Groups whose options differ per sequence (a manifest's own "set") would share a name.
+  for (SeedGroup& group : summarised) {
+    if (name_count[group.name] > 1) group.name += " (" + group.sequences.front() + ", ...)";
   }
   return summarised;
 }

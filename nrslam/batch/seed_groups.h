@@ -16,7 +16,8 @@ namespace nrslam {
 
 struct SeedGroup {
   // The preset, any other simulator settings, "rigid" for a rigid group and the sweep point:
-  // "sim-3", "sim-3 camera.width=320 rigid [k=2]".
+  // "sim-3", "sim-3 camera.width=320 rigid [k=2]"; and where two groups would still share a
+  // name (their options differ per sequence), the first member: "sim-3 (mine-1, ...)".
   std::string name;
   std::vector<std::string> sequences;  // manifest names of the members, in manifest order
   std::vector<std::string> seeds;      // their scene seeds, as the manifest gives them
