@@ -37,12 +37,12 @@ std::string SeedOf(const std::vector<std::string>& arguments) {
   return "default";
 }
 
+// A render's description is its preset; its other settings follow the "--set"s.
 std::string GroupName(const PrepareJob& render, const RunJob& run) {
-  std::string name;
+  std::string name = render.description;
   const std::vector<std::string> arguments = WithoutSeed(render.arguments);
-  for (size_t i = 0; i < arguments.size(); ++i) {
-    if (arguments[i] == "--preset" && i + 1 < arguments.size()) name = arguments[i + 1] + name;
-    if (arguments[i] == "--set" && i + 1 < arguments.size()) name += " " + arguments[i + 1];
+  for (size_t i = 0; i + 1 < arguments.size(); ++i) {
+    if (arguments[i] == "--set") name += " " + arguments[i + 1];
   }
   const bool swept_rigidity = std::any_of(run.point.begin(), run.point.end(), [](const std::string& assignment) {
     return assignment.rfind("tracking.rigid=", 0) == 0;
@@ -53,15 +53,14 @@ std::string GroupName(const PrepareJob& render, const RunJob& run) {
 }
 
 void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
-  std::vector<double> rmse;
+  std::vector<double> rmse, ate;
   bool every_ate = true;
-  double ate_sum = 0;
   for (const RunResult* result : members) {
     if (result->status == "failed" || !result->evaluated()) continue;
     if (result->complete()) ++group->to_end;
     rmse.push_back(result->rmse_mm);
+    ate.push_back(result->ate_mm);
     every_ate = every_ate && result->ate_mm >= 0;
-    ate_sum += result->ate_mm;
   }
   group->scored = static_cast<int>(rmse.size());
   if (rmse.empty()) return;
@@ -72,7 +71,7 @@ void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
   group->median_rmse_mm = Median(rmse);
   group->min_rmse_mm = *std::min_element(rmse.begin(), rmse.end());
   group->max_rmse_mm = *std::max_element(rmse.begin(), rmse.end());
-  group->mean_ate_mm = every_ate ? ate_sum / rmse.size() : -1;
+  group->mean_ate_mm = every_ate ? Mean(ate) : -1;
 }
 
 std::string Joined(const std::vector<std::string>& words) {
