@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "nrslam/batch/evaluation_plan.h"
@@ -309,11 +310,46 @@ TEST(Results, SweepSummaryCountsRunsBetterAndWorseThanTheDefault) {
   EXPECT_EQ(values[1].against_default.same, 2);
   EXPECT_EQ(values[1].against_default.worse, 1);
   EXPECT_DOUBLE_EQ(values[1].against_default.SignTestP(), 0.625);  // 3 against 1: 2 · 5/16
+  // All six pairs, the two "same" ones too, in the geometric mean ratio; the signed-rank test
+  // over the four that moved (see SignedRankTestKnownAnswers).
+  EXPECT_NEAR(values[1].against_default.GeometricMeanRatio(),
+              std::pow(0.5 * 0.5 * (2.0003 / 2) * (1.9998 / 2) * 3 * 0.8, 1.0 / 6), 1e-12);
+  EXPECT_DOUBLE_EQ(values[1].against_default.SignedRankP(), 0.875);
   for (size_t i : {2u, 3u}) EXPECT_FALSE(values[i].paired || values[i].is_default) << values[i].value;
   std::stringstream table;
   PrintResults(results, table);
   EXPECT_NE(table.str().find("3 / 2 / 1"), std::string::npos) << table.str();
   EXPECT_NE(table.str().find("(default)"), std::string::npos) << table.str();
+}
+
+// Known answers of the two-sided Wilcoxon signed-rank test on log(RMSE / reference).
+TEST(Results, SignedRankTestKnownAnswers) {
+  // Pairs (reference, RMSE) whose |log ratio| has rank r (1-based), worse when r is in `worse`.
+  const auto ranked = [](int n, const std::set<int>& worse) {
+    RmseChangeCounts counts;
+    for (int r = 1; r <= n; ++r) counts.Add(1.0, std::exp((worse.count(r) ? 0.01 : -0.01) * r));
+    return counts;
+  };
+  // Every run better: of the 2^5 sign patterns only this one and its mirror are as extreme.
+  EXPECT_DOUBLE_EQ(ranked(5, {}).SignedRankP(), 2.0 / 32);
+  // The worse runs' ranks sum to 8: 25 of the 1024 subsets of 1..10 sum to at most 8.
+  EXPECT_DOUBLE_EQ(ranked(10, {1, 3, 4}).SignedRankP(), 50.0 / 1024);
+  EXPECT_DOUBLE_EQ(ranked(10, {1, 3, 4}).SignedRankP(), ranked(10, {2, 5, 6, 7, 8, 9, 10}).SignedRankP());
+  // Tied sizes share their mean rank: ranks 1, 2.5, 2.5, 4 with the worse run's 4; rank sums
+  // ≤ 4 come from 7 of the 16 sign patterns.
+  RmseChangeCounts tied;
+  for (double rmse : {0.8, 0.5, 0.5, 3.0}) tied.Add(1.0, rmse);
+  tied.Add(2.0, 2.0003);  // "same": left out of the test
+  EXPECT_DOUBLE_EQ(tied.SignedRankP(), 14.0 / 16);
+  // Either side of the switch to the normal approximation (200 → 201 runs), every other rank
+  // worse: both p ≈ 0.952 (z ≈ 0.06).
+  std::set<int> even;
+  for (int r = 2; r <= 200; r += 2) even.insert(r);
+  EXPECT_NEAR(ranked(200, even).SignedRankP(), 0.952, 0.005);
+  EXPECT_NEAR(ranked(201, even).SignedRankP(), 0.952, 0.005);
+  EXPECT_LT(ranked(300, {}).SignedRankP(), 1e-40);
+  EXPECT_DOUBLE_EQ(RmseChangeCounts().SignedRankP(), 1.0);
+  EXPECT_DOUBLE_EQ(RmseChangeCounts().GeometricMeanRatio(), 1.0);
 }
 
 // Known answers of the two-sided exact sign test: 2 · P(Binomial(n, 1/2) ≥ the larger count).
@@ -372,7 +408,9 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
   EXPECT_EQ(diff.only_in_b, 1);
   std::stringstream table;
   PrintDiff(diff, "before", "after", table);
-  for (const char* expected : {"1 / 1 / 1", "p = 1.000", "absent", "FAILED", "-1.000", "0.500"}) {
+  EXPECT_NEAR(diff.b_against_a.GeometricMeanRatio(), std::cbrt(1.0003 * (2.0 / 3) * 1.25), 1e-12);
+  for (const char* expected : {"1 / 1 / 1", "p = 1.000", "absent", "FAILED", "-1.000", "0.500",
+                               "geometric mean over the runs: 0.941"}) {
     EXPECT_NE(table.str().find(expected), std::string::npos) << expected << "\n" << table.str();
   }
   // A run without a trajectory error leaves the mean ATE out rather than averaging a gap.
@@ -478,7 +516,10 @@ TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
   EXPECT_EQ(tally.same_points.ToString(), "0 / 0 / 0");
   table.str("");
   PrintRigidComparison(three, table);
-  EXPECT_NE(table.str().find("own RMSE 2 / 0 / 1 (sign test p = 1.000); common frames 2 / 0 / 1"),
+  // Own: ratios rigid / deformable 1/6, 2, 2, geometric mean 1.5^(-1/3) = 0.874; |log ratio|
+  // ranks 1.5, 1.5, 3 with the worse run's 3, as likely as not under the null: p = 1.
+  EXPECT_NE(table.str().find("own RMSE 2 / 0 / 1 (sign test p = 1.000; ratio, geometric mean 0.874, signed-rank p = "
+                             "1.000); common frames 2 / 0 / 1 (sign test p = 1.000; ratio, geometric mean 1.260"),
             std::string::npos)
       << table.str();
   std::filesystem::remove_all(folder);

@@ -82,7 +82,64 @@ std::string RunKey(const RunResult& result) {
 
 void RmseChangeCounts::Add(double reference_mm, double rmse_mm) {
   const double change = rmse_mm - reference_mm;
-  ++(std::abs(change) < 5e-4 ? same : change < 0 ? better : worse);
+  const bool unchanged = std::abs(change) < 5e-4;
+  ++(unchanged ? same : change < 0 ? better : worse);
+  if (reference_mm > 0 && rmse_mm > 0) {
+    log_ratios.push_back(std::log(rmse_mm / reference_mm));
+    pair_moved.push_back(!unchanged);
+  }
+}
+
+double RmseChangeCounts::GeometricMeanRatio() const {
+  if (log_ratios.empty()) return 1.0;
+  double sum = 0;
+  for (double r : log_ratios) sum += r;
+  return std::exp(sum / log_ratios.size());
+}
+
+double RmseChangeCounts::SignedRankP() const {
+  std::vector<double> changes;
+  for (size_t i = 0; i < log_ratios.size(); ++i) {
+    if (pair_moved[i]) changes.push_back(log_ratios[i]);
+  }
+  const int n = static_cast<int>(changes.size());
+  if (n == 0) return 1.0;
+  std::sort(changes.begin(), changes.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
+  // Ranks of |change|, ties sharing their mean rank; doubled so that every rank is an integer.
+  std::vector<int> doubled_rank(n);
+  double tie_term = 0;  // sum of t³ − t over the tie groups
+  for (int first = 0; first < n;) {
+    int last = first;
+    while (last + 1 < n && std::abs(changes[last + 1]) == std::abs(changes[first])) ++last;
+    for (int i = first; i <= last; ++i) doubled_rank[i] = first + last + 2;
+    const double t = last - first + 1;
+    tie_term += t * t * t - t;
+    first = last + 1;
+  }
+  int doubled_w_plus = 0;  // twice the rank sum of the runs that got worse
+  for (int i = 0; i < n; ++i) doubled_w_plus += changes[i] > 0 ? doubled_rank[i] : 0;
+  const int doubled_total = n * (n + 1);
+  if (n <= 200) {
+    // Distribution of the doubled rank sum when each run's sign is a fair coin.
+    std::vector<double> probability(doubled_total + 1, 0.0);
+    probability[0] = 1;
+    int reach = 0;
+    for (int r : doubled_rank) {
+      for (int s = reach; s >= 0; --s) {
+        probability[s + r] += 0.5 * probability[s];
+        probability[s] *= 0.5;
+      }
+      reach += r;
+    }
+    double lower = 0, upper = 0;
+    for (int s = 0; s <= doubled_total; ++s) (s <= doubled_w_plus ? lower : upper) += probability[s];
+    upper += probability[doubled_w_plus];  // P(W+ >= w) includes w itself
+    return std::min(1.0, 2 * std::min(lower, upper));
+  }
+  const double mean = n * (n + 1) / 4.0;
+  const double variance = n * (n + 1) * (2.0 * n + 1) / 24.0 - tie_term / 48.0;
+  const double distance = std::max(0.0, std::abs(doubled_w_plus / 2.0 - mean) - 0.5);  // continuity correction
+  return variance > 0 ? std::min(1.0, std::erfc(distance / std::sqrt(2 * variance))) : 1.0;
 }
 
 double RmseChangeCounts::SignTestP() const {
@@ -238,16 +295,17 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
 
 std::vector<std::string> SweepSummaryHeader() {
   return {"option", "value", "mean RMSE mm", "median mm", "mean ATE mm", "runs", "not to end",
-          "vs default: better / same / worse", "sign test p"};
+          "vs default: better / same / worse", "sign test p", "RMSE ratio to default", "signed-rank p"};
 }
 
 std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const bool any = v.runs > 0;
   const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
-  const std::string p = v.paired ? FormatFixed(v.against_default.SignTestP(), 3) : "-";
+  const auto if_paired = [&v](double figure) { return v.paired ? FormatFixed(figure, 3) : std::string("-"); };
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
           any ? AteCell(v.mean_ate_mm) : "-", std::to_string(v.runs),
-          std::to_string(v.short_runs), paired, p};
+          std::to_string(v.short_runs), paired, if_paired(v.against_default.SignTestP()),
+          if_paired(v.against_default.GeometricMeanRatio()), if_paired(v.against_default.SignedRankP())};
 }
 
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results) {

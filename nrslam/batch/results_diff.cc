@@ -87,7 +87,9 @@ void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::st
     summary.Print(out);
     out << "B against A, run for run (better / same / worse): " << diff.b_against_a.ToString()
         << "; two-sided sign test over the runs that moved: p = " << FormatFixed(diff.b_against_a.SignTestP(), 3)
-        << '\n';
+        << "\nRMSE ratio B / A, geometric mean over the runs: " << FormatFixed(diff.b_against_a.GeometricMeanRatio(), 3)
+        << "; two-sided Wilcoxon signed-rank test of log(B / A) over the runs that moved: p = "
+        << FormatFixed(diff.b_against_a.SignedRankP(), 3) << '\n';
   }
   out << "Not tracked to the end (lost or failed): in A only " << diff.short_only_a << ", in B only "
       << diff.short_only_b << ", in both " << diff.short_both << '\n';

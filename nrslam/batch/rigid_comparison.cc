@@ -96,7 +96,9 @@ RigidComparisonTally TallyRigidComparisons(const std::vector<RigidComparison>& c
 
 std::string RigidComparisonTallyText(const RigidComparisonTally& tally) {
   const auto count = [](const RmseChangeCounts& counts) {
-    return counts.ToString() + " (sign test p = " + FormatFixed(counts.SignTestP(), 3) + ")";
+    // The ratio the other way up, as the table's: rigid / deformable, above 1 where deformable wins.
+    return counts.ToString() + " (sign test p = " + FormatFixed(counts.SignTestP(), 3) + "; ratio, geometric mean " +
+           FormatFixed(1 / counts.GeometricMeanRatio(), 3) + ", signed-rank p = " + FormatFixed(counts.SignedRankP(), 3) + ")";
   };
   return "Deformable better / same / worse than rigid: own RMSE " + count(tally.own) + "; common frames " +
          count(tally.common) + "; same points " + count(tally.same_points) + ".";
