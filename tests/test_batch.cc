@@ -116,6 +116,66 @@ TEST(Manifest, ShippedSimulationManifestsAreValid) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(Seeds, ListsAndRangesOfSceneSeeds) {
+  EXPECT_EQ(ParseSeedList("1-3,7"), (std::vector<uint64_t>{1, 2, 3, 7}));
+  EXPECT_EQ(ParseSeedList("5"), (std::vector<uint64_t>{5}));
+  for (const char* bad : {"", "3-1", "a", "1,1", "1-2,2", "-1", "1-", "1,,2", "0-1000"}) {
+    EXPECT_THROW(ParseSeedList(bad), Error) << bad;
+  }
+}
+
+// Each preset once per seed, named after it, with the manifest's own seed replaced; sequences
+// on disk and external results (scored against one rendering) once, as they are.
+TEST(Seeds, EveryPresetOncePerSeed) {
+  Manifest manifest;
+  ManifestSequence preset;
+  preset.name = "s";
+  preset.preset = "sim-3";
+  preset.simulate = {"frames=30", "seed=9"};
+  ManifestSequence on_disk;
+  on_disk.name = "p";
+  on_disk.path = "/data/p";
+  ManifestSequence external = preset;
+  external.name = "defslam";
+  external.external.estimates = "defslam.csv";
+  manifest.sequences = {preset, on_disk, external};
+  const Manifest seeded = WithSceneSeeds(manifest, {1, 2});
+  ASSERT_EQ(seeded.sequences.size(), 4u);
+  EXPECT_EQ(seeded.sequences[0].name, "s-seed1");
+  EXPECT_EQ(seeded.sequences[0].simulate, (std::vector<std::string>{"frames=30", "seed=1"}));
+  EXPECT_EQ(seeded.sequences[1].name, "s-seed2");
+  EXPECT_EQ(seeded.sequences[1].simulate, (std::vector<std::string>{"frames=30", "seed=2"}));
+  EXPECT_EQ(seeded.sequences[2].name, "p");
+  EXPECT_EQ(seeded.sequences[3].name, "defslam");
+  EXPECT_EQ(seeded.sequences[3].simulate, preset.simulate);
+  // A copy's name must not be taken already.
+  on_disk.name = "s-seed2";
+  manifest.sequences = {preset, on_disk};
+  EXPECT_THROW(WithSceneSeeds(manifest, {1, 2}), Error);
+}
+
+// --seeds 1-3 on the monocular suite plans the shipped colon-seeds manifest's runs: the same
+// names, the same renders (so the cache is shared) and the same options.
+TEST(Seeds, TheSuiteOverThreeSeedsIsTheShippedSeedManifest) {
+  const auto folder = UniqueTempFolder("seeded_suite");
+  const std::filesystem::path manifests(NRSLAM_MANIFEST_DIR);
+  const EvaluationPlan seeded =
+      PlanEvaluation(WithSceneSeeds(LoadManifest(manifests / "paper-sim-monocular.json"), ParseSeedList("1-3")), {}, {},
+                     folder / "out", folder / "cache");
+  const EvaluationPlan shipped =
+      PlanEvaluation(LoadManifest(manifests / "colon-seeds-monocular.json"), {}, {}, folder / "out", folder / "cache");
+  ASSERT_EQ(shipped.runs.size(), 21u);
+  for (const RunJob& run : shipped.runs) {
+    SCOPED_TRACE(run.sequence);
+    const auto same = std::find_if(seeded.runs.begin(), seeded.runs.end(),
+                                   [&run](const RunJob& other) { return other.sequence == run.sequence; });
+    ASSERT_NE(same, seeded.runs.end());
+    EXPECT_EQ(seeded.prepares[same->prepare].folder, shipped.prepares[run.prepare].folder);
+    EXPECT_EQ(same->options, run.options);
+  }
+  std::filesystem::remove_all(folder);
+}
+
 TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
   const auto folder = UniqueTempFolder("sweep_plan");
   const Manifest manifest =

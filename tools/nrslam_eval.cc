@@ -70,6 +70,12 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   return code;
 }
 
+// The manifest, with each preset once per scene seed when --seeds gives any.
+nrslam::Manifest LoadSeeded(const std::filesystem::path& file, const std::string& seeds) {
+  const nrslam::Manifest manifest = nrslam::LoadManifest(file);
+  return seeds.empty() ? manifest : nrslam::WithSceneSeeds(manifest, nrslam::ParseSeedList(seeds));
+}
+
 int Compare(const std::filesystem::path& a, const std::filesystem::path& b) {
   const nrslam::CommonPointsComparison comparison = nrslam::CompareRunFolders(a, b);
   if (comparison.frames == 0) throw nrslam::Error("no frame that both runs report could be evaluated");
@@ -97,6 +103,7 @@ int main(int argc, char** argv) {
   std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline,
       config_path;
   std::vector<std::string> assignments, sweeps;
+  std::string seeds;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   double tolerance = 0.10;
   double run_timeout = 0;
@@ -114,6 +121,9 @@ int main(int argc, char** argv) {
                                           "object): those that differ from the defaults, before --set");
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");
   app.add_option("--sweep", sweeps, "run a grid: --sweep k=0.5,1.1,2 --sweep max_degree_D=3,5,10");
+  app.add_option("--seeds", seeds,
+                 "render every preset of the manifest once per scene seed, e.g. --seeds 1-3 (names get -seedN; "
+                 "the seed table summarises each preset over them)");
   app.add_option("--emit-jobs", emit_jobs, "write one shell command per run to FILE (for GNU parallel, Slurm) "
                                             "instead of running them");
   app.add_option("--check-baseline", check_baseline, "fail (exit 3) when a run is worse than this baseline file");
@@ -169,7 +179,7 @@ int main(int argc, char** argv) {
     for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
     if (merge->parsed()) {
       // Runs of the same plan executed elsewhere: gather their run folders under --out.
-      const nrslam::Manifest manifest = nrslam::LoadManifest(merge_manifest);
+      const nrslam::Manifest manifest = LoadSeeded(merge_manifest, seeds);
       nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
       for (nrslam::RunJob& run : plan.runs) {
         for (const std::string& folder : merge_folders) {
@@ -181,14 +191,21 @@ int main(int argc, char** argv) {
       return Finish(plan, out, check_baseline, write_baseline, tolerance);
     }
     if (manifest_path.empty()) throw nrslam::Error("a manifest is required (see data_manifests/)");
-    const nrslam::Manifest manifest = nrslam::LoadManifest(manifest_path);
+    const nrslam::Manifest manifest = LoadSeeded(manifest_path, seeds);
     const nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
     std::filesystem::create_directories(out);
     if (!emit_jobs.empty()) {
       std::ofstream file(emit_jobs);
       for (const nrslam::RunJob& run : plan.runs) file << nrslam::RunShellLine(plan, run, programs) << '\n';
+      // merge must plan the same runs, so it is given every option that shapes the plan.
+      std::string plan_options;
+      if (!config_path.empty()) plan_options += " --config " + config_path;
+      for (const std::string& a : assignments) plan_options += " --set " + a;
+      for (const std::string& sweep : sweeps) plan_options += " --sweep " + sweep;
+      if (!seeds.empty()) plan_options += " --seeds " + seeds;
       std::cout << plan.runs.size() << " job(s) written to " << emit_jobs
-                << "; run them anywhere, then: nrslam_eval merge " << manifest_path << " --out " << out << '\n';
+                << "; run them anywhere, then: nrslam_eval merge " << manifest_path << " --out " << out << plan_options
+                << '\n';
       return 0;
     }
     std::cerr << manifest.sequences.size() << " sequence(s), " << plan.runs.size() << " run(s), " << jobs

@@ -1,7 +1,9 @@
 #include "nrslam/batch/evaluation_plan.h"
 
+#include <algorithm>
 #include <fstream>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "nrslam/system/system_options.h"
@@ -61,6 +63,60 @@ Sweep ParseSweep(const std::string& text) {
     if (value.empty()) throw Error("--sweep '" + text + "': empty value");
   }
   return sweep;
+}
+
+std::vector<uint64_t> ParseSeedList(const std::string& text) {
+  const auto number = [&text](const std::string& digits) {
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 18) {
+      throw Error("--seeds '" + text + "': expected seeds and ranges such as 1-3,7");
+    }
+    return std::stoull(digits);
+  };
+  std::vector<uint64_t> seeds;
+  for (const std::string& item : SplitList(text)) {
+    const size_t dash = item.find('-');
+    const uint64_t first = number(item.substr(0, dash));
+    const uint64_t last = dash == std::string::npos ? first : number(item.substr(dash + 1));
+    if (last < first) throw Error("--seeds '" + text + "': range " + item + " runs backwards");
+    if (last - first >= 1000) throw Error("--seeds '" + text + "': range " + item + " has more than 1000 seeds");
+    for (uint64_t seed = first; seed <= last; ++seed) {
+      if (std::find(seeds.begin(), seeds.end(), seed) != seeds.end()) {
+        throw Error("--seeds '" + text + "': seed " + std::to_string(seed) + " is given twice");
+      }
+      seeds.push_back(seed);
+    }
+  }
+  if (seeds.empty()) throw Error("--seeds '" + text + "': no seed given");
+  return seeds;
+}
+
+Manifest WithSceneSeeds(const Manifest& manifest, const std::vector<uint64_t>& seeds) {
+  Manifest seeded = manifest;
+  seeded.sequences.clear();
+  std::set<std::string> names;
+  const auto add = [&](const ManifestSequence& sequence) {
+    if (!names.insert(sequence.name).second) {
+      throw Error("--seeds: two sequences would be named '" + sequence.name + "'; rename one in the manifest");
+    }
+    seeded.sequences.push_back(sequence);
+  };
+  for (const ManifestSequence& sequence : manifest.sequences) {
+    if (sequence.preset.empty() || sequence.is_external()) {
+      add(sequence);
+      continue;
+    }
+    for (const uint64_t seed : seeds) {
+      ManifestSequence copy = sequence;
+      copy.name += "-seed" + std::to_string(seed);
+      copy.simulate.erase(std::remove_if(copy.simulate.begin(), copy.simulate.end(),
+                                         [](const std::string& a) { return a.rfind("seed=", 0) == 0; }),
+                          copy.simulate.end());
+      copy.simulate.push_back(Assignment("seed", Json(seed)));
+      std::sort(copy.simulate.begin(), copy.simulate.end());
+      add(copy);
+    }
+  }
+  return seeded;
 }
 
 EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::string>& extra,

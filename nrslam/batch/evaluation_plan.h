@@ -2,6 +2,7 @@
 // one nrslam_run per (sequence, sweep point) — and running it with a few processes at a time.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -18,6 +19,15 @@ struct Sweep {
 };
 // Parses "name=v1,v2,v3" (name as for ResolveRunOption); throws Error when malformed.
 Sweep ParseSweep(const std::string& text);
+
+// Scene seeds as --seeds gives them: "1-3,7" is 1, 2, 3, 7, in that order. Throws Error when
+// malformed or when a seed comes twice.
+std::vector<uint64_t> ParseSeedList(const std::string& text);
+// The manifest with each rendered preset once per seed, named "<name>-seed<s>", its simulator
+// seed set to s whatever the manifest gave: single renderings are chaotic, and the seed groups
+// of the results summarise such copies. Sequences on disk and external results (scored
+// against one rendering) stay as they are. Throws Error when a new name is already taken.
+Manifest WithSceneSeeds(const Manifest& manifest, const std::vector<uint64_t>& seeds);
 
 // A sequence made before its runs, into the cache: a preset rendered (nrslam_simulate) or a
 // dataset imported (nrslam_import). Its folder name is keyed by what makes it.
