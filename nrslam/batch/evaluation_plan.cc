@@ -65,6 +65,8 @@ Sweep ParseSweep(const std::string& text) {
   return sweep;
 }
 
+bool IsSeedAssignment(const std::string& assignment) { return assignment.rfind("seed=", 0) == 0; }
+
 std::vector<uint64_t> ParseSeedList(const std::string& text) {
   const auto number = [&text](const std::string& digits) {
     if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 18) {
@@ -108,8 +110,7 @@ Manifest WithSceneSeeds(const Manifest& manifest, const std::vector<uint64_t>& s
     for (const uint64_t seed : seeds) {
       ManifestSequence copy = sequence;
       copy.name += "-seed" + std::to_string(seed);
-      copy.simulate.erase(std::remove_if(copy.simulate.begin(), copy.simulate.end(),
-                                         [](const std::string& a) { return a.rfind("seed=", 0) == 0; }),
+      copy.simulate.erase(std::remove_if(copy.simulate.begin(), copy.simulate.end(), IsSeedAssignment),
                           copy.simulate.end());
       copy.simulate.push_back(Assignment("seed", Json(seed)));
       std::sort(copy.simulate.begin(), copy.simulate.end());

@@ -20,6 +20,8 @@ struct Sweep {
 // Parses "name=v1,v2,v3" (name as for ResolveRunOption); throws Error when malformed.
 Sweep ParseSweep(const std::string& text);
 
+// A simulator assignment that sets the scene seed: "seed=3".
+bool IsSeedAssignment(const std::string& assignment);
 // Scene seeds as --seeds gives them: "1-3,7" is 1, 2, 3, 7, in that order. Throws Error when
 // malformed or when a seed comes twice.
 std::vector<uint64_t> ParseSeedList(const std::string& text);

@@ -12,10 +12,6 @@
 namespace nrslam {
 namespace {
 
-constexpr char kSeedAssignment[] = "seed=";
-
-bool IsSeedAssignment(const std::string& argument) { return argument.rfind(kSeedAssignment, 0) == 0; }
-
 // The render arguments without the seed: {"--preset", "sim-3", "--quiet", "--set", "seed=2"}
 // gives {"--preset", "sim-3", "--quiet"}.
 std::vector<std::string> WithoutSeed(const std::vector<std::string>& arguments) {
@@ -32,7 +28,7 @@ std::vector<std::string> WithoutSeed(const std::vector<std::string>& arguments) 
 
 std::string SeedOf(const std::vector<std::string>& arguments) {
   for (const std::string& argument : arguments) {
-    if (IsSeedAssignment(argument)) return argument.substr(sizeof(kSeedAssignment) - 1);
+    if (IsSeedAssignment(argument)) return argument.substr(argument.find('=') + 1);
   }
   return "default";
 }
@@ -72,12 +68,6 @@ void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
   group->min_rmse_mm = *std::min_element(rmse.begin(), rmse.end());
   group->max_rmse_mm = *std::max_element(rmse.begin(), rmse.end());
   group->mean_ate_mm = every_ate ? Mean(ate) : -1;
-}
-
-std::string Joined(const std::vector<std::string>& words) {
-  std::string text;
-  for (const std::string& word : words) text += (text.empty() ? "" : " ") + word;
-  return text;
 }
 
 }  // namespace
@@ -123,7 +113,7 @@ std::vector<std::string> SeedGroupHeader() {
 }
 
 std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
-  const std::string seeds = Joined(group.seeds);
+  const std::string seeds = Join(group.seeds, " ");
   const bool any = group.scored > 0;
   const auto mm = [any](double value) { return any ? FormatFixed(value, 3) : "-"; };
   return {group.name,
@@ -152,7 +142,7 @@ void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem
   csv << "preset,seeds,sequences,runs,scored,to_end,mean_rmse_mm,sd_rmse_mm,median_rmse_mm,min_rmse_mm,max_rmse_mm,"
          "mean_ate_mm\n";
   for (const SeedGroup& group : groups) {
-    csv << CsvField(group.name) << ',' << Joined(group.seeds) << ',' << Joined(group.sequences) << ','
+    csv << CsvField(group.name) << ',' << Join(group.seeds, " ") << ',' << Join(group.sequences, " ") << ','
         << group.seeds.size() << ',' << group.scored << ',' << group.to_end;
     if (group.scored > 0) {
       csv << ',' << group.mean_rmse_mm << ',';

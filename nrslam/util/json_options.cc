@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "nrslam/util/text_table.h"
+
 namespace nrslam {
 namespace {
 
@@ -62,12 +64,6 @@ void CollectMismatches(const Json& given, const Json& reference, const std::stri
     }
     CollectMismatches(it.value(), expected, path, unknown, mistyped);
   }
-}
-
-std::string Join(const std::vector<std::string>& items, const std::string& separator) {
-  std::string out;
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
-  return out;
 }
 
 Json ParseLike(const Json& existing, const std::string& text, const std::string& path) {

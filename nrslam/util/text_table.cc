@@ -27,6 +27,12 @@ void TextTable::Print(std::ostream& out) const {
   for (const auto& row : rows_) print_row(row);
 }
 
+std::string Join(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
+  return out;
+}
+
 std::string FormatFixed(double value, int decimals) {
   char text[64];
   std::snprintf(text, sizeof(text), "%.*f", decimals, value);

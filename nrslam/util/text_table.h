@@ -1,4 +1,4 @@
-// util: fixed-width text tables for the programs' result summaries.
+// util: fixed-width text tables and the number and list formatting of the programs' summaries.
 #pragma once
 
 #include <ostream>
@@ -21,5 +21,7 @@ class TextTable {
 
 // Fixed-point text of a number: FormatFixed(3.14159, 2) == "3.14".
 std::string FormatFixed(double value, int decimals);
+// The items with `separator` between them: Join({"a", "b"}, ", ") == "a, b".
+std::string Join(const std::vector<std::string>& items, const std::string& separator);
 
 }  // namespace nrslam
