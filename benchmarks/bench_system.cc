@@ -17,11 +17,13 @@
 #include "bench_options.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
+#include "nrslam/util/source_revision.h"
 
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   CLI::App app{"Whole-system speed and memory of monocular NR-SLAM on simulated sequences at 640x480"};
+  app.set_version_flag("--version", nrslam::VersionString());
   int frames = 120;
   std::vector<std::string> presets = {"sim-0", "sim-3", "sim-6"};
   app.add_option("frames", frames, "frames per sequence")->check(CLI::Range(2, 100000));
@@ -33,6 +35,7 @@ int main(int argc, char** argv) {
   if (!options) return 1;
   const fs::path work = fs::temp_directory_path() / ("nrslam_bench_system_" + std::to_string(::getpid()));
   // "linear ms" is inside "track ms": the joint solves' linear solver.
+  std::printf("%s\n", nrslam::VersionString().c_str());
   std::printf("%-8s %-10s %6s %7s %9s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
               "linear ms", "DBA ms", "triang ms", "RMSE mm", "points");
   for (const std::string& preset : presets) {

@@ -11,9 +11,11 @@
 #include "bench_options.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/tracking/tracker.h"
+#include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Tracking speed at 640x480 from a depth-initialised map (sim-0, sim-3, sim-6)"};
+  app.set_version_flag("--version", nrslam::VersionString());
   int frames = 60;
   app.add_option("frames", frames, "frames per preset, the first one initialising")->check(CLI::Range(2, 100000));
   std::vector<std::string> assignments;
@@ -22,6 +24,7 @@ int main(int argc, char** argv) {
   const std::optional<nrslam::SystemOptions> options = BenchmarkOptions(assignments);
   if (!options) return 1;
   // "solve" and "linear" are inside "deform": Ceres's joint solves and their linear solver.
+  std::printf("%s\n", nrslam::VersionString().c_str());
   std::printf("%-8s %-10s %7s %8s %8s %9s %8s %9s %8s %8s\n", "preset", "mode", "fps", "klt ms", "pose ms", "deform ms",
               "solve ms", "linear ms", "total ms", "points");
   for (const std::string preset : {"sim-0", "sim-3", "sim-6"}) {

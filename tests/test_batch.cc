@@ -22,6 +22,7 @@
 #include "nrslam/batch/seed_groups.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/source_revision.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -222,6 +223,28 @@ TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
   const BaselineCheck crash = CheckBaseline({Result("a", 1.0, 60), failed}, baseline);
   EXPECT_FALSE(crash.passed);
   EXPECT_NE(crash.report.find("FAILED: boom"), std::string::npos);
+  // The report says which code made the baseline and which made the runs checked against it.
+  EXPECT_NE(crash.report.find("code of the baseline: not recorded; of these runs: not recorded"), std::string::npos)
+      << crash.report;
+  std::vector<RunResult> recorded = before;
+  recorded[0].revision = "0123456789ab";
+  recorded[1].revision = "0123456789ab-dirty-fedcba98";
+  const Json from_recorded = MakeBaseline(recorded, BaselineTolerance{});
+  EXPECT_EQ(from_recorded["runs"]["a"]["revision"], "0123456789ab");
+  EXPECT_NE(CheckBaseline(before, from_recorded)
+                .report.find("code of the baseline: 0123456789ab, 0123456789ab-dirty-fedcba98; of these runs: not recorded"),
+            std::string::npos);
+}
+
+TEST(Results, RevisionsAreListedOnceSortedWithTheUnrecordedLast) {
+  EXPECT_EQ(DescribeRevisions(std::vector<std::string>{}), "not recorded");
+  EXPECT_EQ(DescribeRevisions(std::vector<std::string>{"b", "", "a", "b"}), "a, b, not recorded");
+  EXPECT_EQ(DescribeRevisions(std::vector<std::string>{"b", "b"}), "b");
+  RunResult run = Result("a", 1.0, 60);
+  run.revision = "0123456789ab";
+  EXPECT_EQ(ResultsFromJson(ToJson({run}))[0].revision, "0123456789ab");
+  EXPECT_TRUE(ToJson({Result("a", 1.0, 60)})["results"][0]["revision"].is_null());
+  EXPECT_EQ(ResultsFromJson(ToJson({Result("a", 1.0, 60)}))[0].revision, "");
 }
 
 // A run without ground truth (a plain video) shows no RMSE rather than a perfect 0.000.
@@ -468,6 +491,7 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
   EXPECT_EQ(diff.only_in_b, 1);
   std::stringstream table;
   PrintDiff(diff, "before", "after", table);
+  EXPECT_NE(table.str().find("A: before (code: not recorded)\nB: after (code: not recorded)"), std::string::npos);
   EXPECT_NEAR(diff.b_against_a.GeometricMeanRatio(), std::cbrt(1.0003 * (2.0 / 3) * 1.25), 1e-12);
   for (const char* expected : {"1 / 1 / 1", "p = 1.000", "absent", "FAILED", "-1.000", "0.500",
                                "geometric mean over the runs: 0.941"}) {
@@ -993,7 +1017,7 @@ TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
   std::vector<std::string> lines;
   ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   ASSERT_EQ(lines.size(), 2u);
-  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options, another sequence or changed estimates: run again");
+  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options, another sequence, changed estimates or other code: run again");
   EXPECT_NE(lines[1].find("[1/1] s done"), std::string::npos) << lines[1];
   const Json config = ReadJsonFile(plain.runs[0].run_folder / "config.json");
   EXPECT_EQ(config.at("options").at("deformation").at("k"), Json(DeformationModelOptions{}.k));
@@ -1001,6 +1025,12 @@ TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
   lines.clear();
   ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   EXPECT_EQ(lines, std::vector<std::string>{"1 run(s) already finished, not run again"});
+  // A run made by other code (another commit, other uncommitted edits) is not reused either.
+  Json other_code = ReadJsonFile(plain.runs[0].run_folder / "config.json");
+  EXPECT_EQ(other_code.at("nrslam_revision"), SourceRevision());
+  other_code["nrslam_revision"] = std::string(SourceRevision()) + "-elsewhere";
+  std::ofstream(plain.runs[0].run_folder / "config.json") << other_code.dump();
+  EXPECT_FALSE(RunIsFinished(plain.runs[0]));
   std::filesystem::remove_all(folder);
 }
 

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <numeric>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -31,6 +32,7 @@
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
+#include "nrslam/util/source_revision.h"
 
 namespace nrslam {
 namespace {
@@ -450,6 +452,10 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   nlohmann::json config;
   std::ifstream(run / "config.json") >> config;
   EXPECT_EQ(config.at("options"), nlohmann::json(TrackingExperiment()));  // every resolved option
+  // ... and the code that ran: a commit, with a hash of uncommitted edits, or "unknown".
+  const std::string revision = config.at("nrslam_revision");
+  EXPECT_EQ(revision, SourceRevision());
+  EXPECT_TRUE(std::regex_match(revision, std::regex("[0-9a-f]{12}(-dirty-[0-9a-f]{8})?|unknown"))) << revision;
   EXPECT_EQ(ReadTum(run / "trajectory.tum").size(), 40u);
   EXPECT_TRUE(fs::exists(run / "depth" / "000039.png"));
   std::ifstream metrics(run / "metrics.csv");

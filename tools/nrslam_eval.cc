@@ -24,6 +24,7 @@
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
 
 namespace {
@@ -99,6 +100,7 @@ int Compare(const std::filesystem::path& a, const std::filesystem::path& b) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Evaluate NR-SLAM over a manifest of sequences"};
+  app.set_version_flag("--version", nrslam::VersionString());
   app.require_subcommand(0, 1);
   std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline,
       config_path;

@@ -6,9 +6,11 @@
 #include <iostream>
 
 #include "nrslam/datasets/dataset_import.h"
+#include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Import a dataset into the nrslam sequence format"};
+  app.set_version_flag("--version", nrslam::VersionString());
   nrslam::ImportOptions options;
   std::string out;
   app.add_option("--format", options.format, "endomapper-sim, hamlyn, c3vd or images")->required();

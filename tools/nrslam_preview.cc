@@ -8,9 +8,11 @@
 
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Write a frame of a sequence (colour | depth) as a PNG."};
+  app.set_version_flag("--version", nrslam::VersionString());
   std::string sequence, out;
   int frame = 0;
   double scale = 1.0, near_mm = 10.0, far_mm = 120.0;

@@ -6,9 +6,11 @@
 
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Run NR-SLAM over a sequence and write its run folder."};
+  app.set_version_flag("--version", nrslam::VersionString());
   std::string sequence, out, config_path, init;
   bool rigid = false, no_mapping = false, quiet = false, print_options = false;
   std::vector<std::string> assignments;

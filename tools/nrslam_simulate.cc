@@ -8,6 +8,7 @@
 
 #include "nrslam/sim/simulate.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
 
 namespace {
@@ -22,6 +23,7 @@ void PrintProgress(const std::string& name, int done, int total, double ms_per_f
 
 int main(int argc, char** argv) {
   CLI::App app{"Render simulated endoscopy sequences with exact depth ground truth."};
+  app.set_version_flag("--version", nrslam::VersionString());
   std::string preset = "sim-0", out, config_path, camera_model;
   bool suite = false, stereo = false, print_options = false, quiet = false;
   int frames = 0, width = 0, height = 0;

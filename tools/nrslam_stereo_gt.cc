@@ -10,9 +10,11 @@
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Depth ground truth from the rectified stereo pairs of a sequence"};
+  app.set_version_flag("--version", nrslam::VersionString());
   std::string folder;
   std::vector<std::string> assignments;
   bool overwrite = false, quiet = false;

@@ -8,6 +8,7 @@
 
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/process.h"
+#include "nrslam/util/source_revision.h"
 
 namespace nrslam {
 namespace {
@@ -266,7 +267,8 @@ bool RunIsFinished(const RunJob& run) {
     // Parsed back through the options struct, so that a config written before an option
     // existed compares as that option's default.
     const Json options = OptionsFromJson<SystemOptions>(config.at("options"), "config.json");
-    return options == run.options && same_sequence;
+    const bool same_code = config.value("nrslam_revision", "") == SourceRevision();
+    return options == run.options && same_sequence && same_code;
   } catch (const std::exception&) {
     return false;  // unreadable, or from a version with options this one lacks: run it again
   }
@@ -329,7 +331,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   }
   if (skipped > 0) progress(std::to_string(skipped) + " run(s) already finished, not run again");
   if (superseded > 0) {
-    progress(std::to_string(superseded) + " run(s) in the output folder had other options, another sequence or changed estimates: run again");
+    progress(std::to_string(superseded) + " run(s) in the output folder had other options, another sequence, changed estimates or other code: run again");
   }
   size_t finished = 0;
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {

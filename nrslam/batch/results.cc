@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "nrslam/system/run_sequence.h"
@@ -75,6 +76,27 @@ std::string PairKey(const RunResult& run, const std::string& option, const std::
 }
 
 }  // namespace
+
+std::string DescribeRevisions(const std::vector<std::string>& revisions) {
+  std::set<std::string> distinct;
+  bool unrecorded = false;
+  for (const std::string& revision : revisions) {
+    if (revision.empty()) {
+      unrecorded = true;
+    } else {
+      distinct.insert(revision);
+    }
+  }
+  std::vector<std::string> names(distinct.begin(), distinct.end());
+  if (unrecorded || names.empty()) names.push_back("not recorded");
+  return Join(names, ", ");
+}
+
+std::string DescribeRevisions(const std::vector<RunResult>& results) {
+  std::vector<std::string> revisions;
+  for (const RunResult& r : results) revisions.push_back(r.revision);
+  return DescribeRevisions(revisions);
+}
 
 std::string RunKey(const RunResult& result) {
   return result.label.empty() ? result.sequence : result.sequence + " [" + result.label + "]";
@@ -186,6 +208,9 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
     try {
       if (std::filesystem::exists(run.run_folder / "summary.json")) {
         ReadFigures(ReadJsonFile(run.run_folder / "summary.json"), &result);
+        if (std::filesystem::exists(run.run_folder / "config.json")) {
+          result.revision = ReadJsonFile(run.run_folder / "config.json").value("nrslam_revision", "");
+        }
         result.status = result.init_frame < 0 ? "not_initialised"
                         : result.frames_tracked + result.init_frame >= result.frames_total ? "ok"
                                                                                           : "lost";
@@ -210,6 +235,7 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
                     {"rmse_flat_mm", r.rmse_flat_mm >= 0 ? Json(r.rmse_flat_mm) : Json()},
                     {"ate_rmse_mm", r.ate_mm >= 0 ? Json(r.ate_mm) : Json()}, {"fps", r.fps}, {"run_folder", r.run_folder},
+                    {"revision", r.revision.empty() ? Json() : Json(r.revision)},
                     {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
                     {"stop_reason", r.stop_reason.empty() ? Json() : Json(r.stop_reason)}});
   }
@@ -228,6 +254,8 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
       r.error = row.value("error", "");
       ReadFigures(row, &r);
       r.run_folder = row.value("run_folder", "");
+      const auto revision = row.find("revision");
+      if (revision != row.end() && revision->is_string()) r.revision = revision->get<std::string>();
       results.push_back(r);
     }
   } catch (const Json::exception& e) {
@@ -378,6 +406,7 @@ Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance
   for (const RunResult& r : results) {
     if (r.status == "failed") continue;
     runs[RunKey(r)] = {{"rmse_mm", r.rmse_mm}, {"frames_tracked", r.frames_tracked}};
+    if (!r.revision.empty()) runs[RunKey(r)]["revision"] = r.revision;
   }
   return {{"tolerance",
            {{"rmse_relative", tolerance.rmse_relative},
@@ -400,6 +429,8 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   }
   std::map<std::string, const RunResult*> by_key;
   for (const RunResult& r : results) by_key[RunKey(r)] = &r;
+  std::vector<std::string> baseline_revisions;
+  for (const auto& [key, expected] : runs.items()) baseline_revisions.push_back(expected.value("revision", ""));
   BaselineCheck check;
   TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
   for (const auto& [key, expected] : runs.items()) {
@@ -430,7 +461,9 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   }
   std::ostringstream report;
   report << "Baseline check (RMSE may grow by " << FormatFixed(100 * tolerance.rmse_relative, 0) << " % + "
-         << tolerance.rmse_absolute_mm << " mm; frames tracked may drop by " << tolerance.frames_tracked << "):\n";
+         << tolerance.rmse_absolute_mm << " mm; frames tracked may drop by " << tolerance.frames_tracked << "):\n"
+         << "code of the baseline: " << DescribeRevisions(baseline_revisions) << "; of these runs: " << DescribeRevisions(results)
+         << '\n';
   table.Print(report);
   report << (check.passed ? "PASSED" : "FAILED: at least one run is worse than the baseline allows") << '\n';
   check.report = report.str();

@@ -24,6 +24,7 @@ struct RunResult {
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
   double rmse_flat_mm = -1;         // what a map at one depth scores on the same points; negative: not recorded
   std::string run_folder;
+  std::string revision;             // the code that made the run (its config.json); "" when not recorded
   // A run that ends without tracking: from which frame, and why (the runner's note); for a run
   // that never initialised, frame -1 and the last frame's note. Empty when it ends tracking.
   int stop_frame = -1;
@@ -38,6 +39,10 @@ std::string CsvField(const std::string& text);
 
 // How tables and baselines name a run: "sequence", or "sequence [sweep point]".
 std::string RunKey(const RunResult& result);
+// The distinct revisions that made `revisions` (RunResult::revision; "" = not recorded), sorted
+// and joined by ", ", e.g. "1a2b3c4d5e6f, not recorded": what code a set of results came from.
+std::string DescribeRevisions(const std::vector<std::string>& revisions);
+std::string DescribeRevisions(const std::vector<RunResult>& results);
 // Paired runs counted by how a run's RMSE compares with its partner's (the reference):
 // "same" when equal to the printed 0.001 mm.
 struct RmseChangeCounts {

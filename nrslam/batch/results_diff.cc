@@ -67,7 +67,13 @@ ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunRe
 }
 
 void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::string& name_b, std::ostream& out) {
-  out << "A: " << name_a << "\nB: " << name_b << "\n\n";
+  std::vector<std::string> revisions_a, revisions_b;
+  for (const ResultsDiff::Row& row : diff.rows) {
+    if (row.a) revisions_a.push_back(row.a->revision);
+    if (row.b) revisions_b.push_back(row.b->revision);
+  }
+  out << "A: " << name_a << " (code: " << DescribeRevisions(revisions_a) << ")\nB: " << name_b
+      << " (code: " << DescribeRevisions(revisions_b) << ")\n\n";
   TextTable table({"run", "A RMSE mm", "A tracked", "A ATE mm", "B RMSE mm", "B tracked", "B ATE mm", "B - A mm"});
   for (const ResultsDiff::Row& row : diff.rows) {
     std::vector<std::string> cells = {row.key};

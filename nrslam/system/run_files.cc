@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/source_revision.h"
 
 namespace nrslam {
 
@@ -69,7 +70,9 @@ RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::fil
   std::filesystem::create_directories(out / "depth", error);
   if (error) throw Error("cannot create " + out.string() + ": " + error.message());
   {
-    nlohmann::json written{{"nrslam_version", NRSLAM_VERSION}, {"sequence", std::filesystem::absolute(sequence).string()}};
+    nlohmann::json written{{"nrslam_version", NRSLAM_VERSION},
+                           {"nrslam_revision", SourceRevision()},
+                           {"sequence", std::filesystem::absolute(sequence).string()}};
     written.update(config);
     std::ofstream file = OpenForWriting(out / "config.json");
     file << written.dump(2) << '\n';

@@ -1,0 +1,18 @@
+// Which code built this library, for the provenance of every result it writes.
+#pragma once
+
+#include <string>
+
+namespace nrslam {
+
+// The git commit the library was built from, 12 hex digits; with "-dirty-" and 8 hex digits
+// of a hash of the uncommitted changes to tracked files when there were any at build time;
+// "unknown" when built outside a git checkout. Written into each run's config.json, so that a
+// figure can be traced to the code that produced it and a run by other code is not reused.
+const char* SourceRevision();
+
+// "nrslam <version> (revision <SourceRevision()>)": what the tools print for --version and
+// the benchmarks above their figures.
+std::string VersionString();
+
+}  // namespace nrslam
