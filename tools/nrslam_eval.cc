@@ -54,7 +54,8 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   std::cout << "\nresults: " << (out / "results.json").string() << ", " << (out / "results.csv").string()
             << (comparisons.empty() ? "" : ", " + (out / "rigid_comparison.csv").string())
             << (seed_groups.empty() ? "" : ", " + (out / "seed_groups.csv").string())
-            << "\nreport:  " << (out / "report" / "index.html").string() << '\n';
+            << "\nreport:  " << (out / "report" / "index.html").string()
+            << "\ncode:    " << nrslam::DescribeRevisions(results) << '\n';
   int code = 0;
   for (const auto& result : results) code = result.status == "failed" ? 2 : code;
   if (!write_baseline.empty()) {
