@@ -743,6 +743,10 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   ASSERT_EQ(read.size(), 3u);
   EXPECT_EQ(read[1].error, results[1].error);
   EXPECT_DOUBLE_EQ(read[0].rmse_mm, results[0].rmse_mm);
+  // Each run names the code that made it; the broken one never wrote a config.
+  EXPECT_EQ(read[0].revision, SourceRevision());
+  EXPECT_EQ(read[1].revision, "");
+  EXPECT_EQ(DescribeRevisions(read), std::string(SourceRevision()) + ", not recorded");
   EXPECT_GT(results[0].rmse_flat_mm, 0.0);
   EXPECT_DOUBLE_EQ(read[0].rmse_flat_mm, results[0].rmse_flat_mm);
   EXPECT_LT(read[1].rmse_flat_mm, 0.0);  // failed: none recorded
@@ -767,6 +771,11 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,
   // and the failed sequence is shown as such.
   WriteReport(results, comparisons, GroupBySeed(plan, results), folder / "out" / "report");
+  {
+    std::ifstream report(folder / "out" / "report" / "index.html");
+    const std::string html((std::istreambuf_iterator<char>(report)), {});
+    EXPECT_NE(html.find("<p>Code: " + DescribeRevisions(results) + "</p>"), std::string::npos);
+  }
   if (std::system("chromium --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "chromium is not installed";
   const std::string dom = (folder / "dom.html").string(), log = (folder / "browser.log").string();
   ASSERT_EQ(std::system(("timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=5000 "

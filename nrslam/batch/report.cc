@@ -245,7 +245,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
          << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FlatRmseCell(r) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
-  html << "</table>\n" << SweepSection(results) << RigidSection(comparisons) << SeedSection(seed_groups);
+  html << "</table>\n<p>Code: " << EscapeXml(DescribeRevisions(results)) << "</p>\n" << SweepSection(results) << RigidSection(comparisons) << SeedSection(seed_groups);
   for (const RunResult& r : results) html << RunSection(r, folder);
   // Self-check for people and for the test that opens the page in a headless browser.
   html << "<script>window.addEventListener('load',()=>{const i=[...document.images];"
