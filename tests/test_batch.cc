@@ -503,6 +503,50 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
   EXPECT_LT(DiffResults(a, no_ate).mean_ate_b_mm, 0);
 }
 
+// The diff says what else differed between the two evaluations' runs: options (from each
+// run's config.json, whatever the evaluations were asked), and the sequence folder.
+TEST(Results, DiffNamesTheOptionsThatDifferBetweenTheRuns) {
+  const auto folder = UniqueTempFolder("diff_options");
+  const auto run = [&](const std::string& name, const std::string& sequence, const Json& options) {
+    RunResult r = Result(name.substr(2), 1.0, 60);
+    r.run_folder = (folder / name).string();
+    WriteFile(folder / name / "config.json", Json{{"sequence", sequence}, {"options", options}}.dump());
+    return r;
+  };
+  Json stiff = SystemOptions{};
+  stiff["deformation"]["k"] = 2.0;
+  Json stiff_wide = stiff;
+  stiff_wide["mapping"]["dba_window"] = 7;
+  Json older = SystemOptions{};
+  older["tracking"].erase("displacement_prior_sigma");  // written before the option existed
+  const std::vector<RunResult> a = {run("a/s", "/seq/s", SystemOptions{}), run("a/t", "/seq/t", older),
+                                    run("a/u", "/seq/u", SystemOptions{}), run("a/v", "/seq/v", SystemOptions{})};
+  std::vector<RunResult> b = {run("b/s", "/seq/s", stiff), run("b/t", "/seq/t-other", stiff_wide),
+                              run("b/u", "/seq/u", SystemOptions{}), run("b/v", "/seq/v", SystemOptions{})};
+  WriteFile(folder / "b/v" / "config.json", "{ not json");
+  const ResultsDiff diff = DiffResults(a, b);
+  EXPECT_EQ(diff.option_changes, (std::map<std::string, int>{{"deformation.k: 1.1 → 2.0", 2},
+                                                              {"mapping.dba_window: 5 → 7", 1}}));
+  EXPECT_EQ(diff.other_sequence, 1);
+  EXPECT_EQ(diff.configs_unread, 1);
+  std::stringstream text;
+  PrintDiff(diff, "A", "B", text);
+  for (const char* expected : {"Options that differ, A → B (runs):\n  deformation.k: 1.1 → 2.0 (2)\n",
+                               "1 run(s) of the same name ran on another sequence folder",
+                               "1 run(s) with a config.json that could not be read"}) {
+    EXPECT_NE(text.str().find(expected), std::string::npos) << expected << "\n" << text.str();
+  }
+  // Runs with the same options say so; a failed run has none to compare.
+  b[1].status = "failed";
+  const ResultsDiff same = DiffResults({a[2]}, {b[2]});
+  EXPECT_TRUE(same.option_changes.empty());
+  std::stringstream same_text;
+  PrintDiff(same, "A", "B", same_text);
+  EXPECT_NE(same_text.str().find("Options: the same in every run both have"), std::string::npos);
+  EXPECT_EQ(DiffResults({a[1]}, {b[1]}).option_changes.size(), 0u);
+  std::filesystem::remove_all(folder);
+}
+
 TEST(RigidComparison, MeansOverTheFramesBothRunsEvaluated) {
   const CommonFramesRmse common = MeanOverCommonFrames({{0, 0.0}, {1, 1.0}, {2, 2.0}, {3, 3.0}}, {{0, 0.0}, {1, 3.0}, {2, 1.0}});
   EXPECT_EQ(common.frames, 3);

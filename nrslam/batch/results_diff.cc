@@ -1,13 +1,56 @@
 #include "nrslam/batch/results_diff.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 
+#include "nrslam/system/system_options.h"
+#include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
 namespace {
+
+// What a run ran with, from its config.json. kNone for a run that has no options to compare
+// (failed, scored from another system, or a result with no folder).
+struct RunConfig {
+  enum Kind { kNone, kRead, kUnreadable } kind = kNone;
+  Json options;           // parsed back through SystemOptions: an option newer than the run reads as its default
+  std::string sequence;
+};
+
+RunConfig ReadRunConfig(const RunResult& run) {
+  const std::filesystem::path file = std::filesystem::path(run.run_folder) / "config.json";
+  if (run.run_folder.empty() || run.status == "failed" || !std::filesystem::exists(file)) return {};
+  try {
+    const Json config = ReadJsonFile(file);
+    if (!config.contains("options")) return {};
+    return {RunConfig::kRead, OptionsFromJson<SystemOptions>(config.at("options"), file.string()),
+            config.value("sequence", "")};
+  } catch (const std::exception&) {
+    return {RunConfig::kUnreadable, Json(), ""};
+  }
+}
+
+// Counts, into `diff`, how the options of the runs A and B both have differ.
+void CountConfigChanges(const RunResult& a, const RunResult& b, ResultsDiff* diff) {
+  const RunConfig config_a = ReadRunConfig(a), config_b = ReadRunConfig(b);
+  if (config_a.kind == RunConfig::kUnreadable || config_b.kind == RunConfig::kUnreadable) {
+    ++diff->configs_unread;
+    return;
+  }
+  if (config_a.kind != RunConfig::kRead || config_b.kind != RunConfig::kRead) return;
+  if (config_a.sequence != config_b.sequence) ++diff->other_sequence;
+  // The same leaves in the same order both ways: "path=value in B" and "path=value in A".
+  const std::vector<std::string> to_b = ChangedAssignments(config_a.options, config_b.options);
+  const std::vector<std::string> to_a = ChangedAssignments(config_b.options, config_a.options);
+  for (size_t i = 0; i < to_b.size(); ++i) {
+    const size_t equals = to_b[i].find('=');
+    ++diff->option_changes[to_b[i].substr(0, equals) + ": " + to_a[i].substr(equals + 1) + " → " +
+                           to_b[i].substr(equals + 1)];
+  }
+}
 
 // RMSE and frames of one side of a row, as the table shows them.
 std::vector<std::string> SideCells(const std::optional<RunResult>& run) {
@@ -40,6 +83,7 @@ ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunRe
       ++(row.a ? diff.only_in_a : diff.only_in_b);
       continue;
     }
+    CountConfigChanges(*row.a, *row.b, &diff);
     if (!row.comparable()) {
       const bool a_short = !row.a->complete(), b_short = !row.b->complete();
       ++(a_short && b_short ? diff.short_both : a_short ? diff.short_only_a : diff.short_only_b);
@@ -73,7 +117,16 @@ void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::st
     if (row.b) revisions_b.push_back(row.b->revision);
   }
   out << "A: " << name_a << " (code: " << DescribeRevisions(revisions_a) << ")\nB: " << name_b
-      << " (code: " << DescribeRevisions(revisions_b) << ")\n\n";
+      << " (code: " << DescribeRevisions(revisions_b) << ")\n";
+  if (diff.option_changes.empty()) {
+    out << "Options: the same in every run both have\n";
+  } else {
+    out << "Options that differ, A → B (runs):\n";
+    for (const auto& [change, runs] : diff.option_changes) out << "  " << change << " (" << runs << ")\n";
+  }
+  if (diff.other_sequence > 0) out << diff.other_sequence << " run(s) of the same name ran on another sequence folder\n";
+  if (diff.configs_unread > 0) out << diff.configs_unread << " run(s) with a config.json that could not be read\n";
+  out << '\n';
   TextTable table({"run", "A RMSE mm", "A tracked", "A ATE mm", "B RMSE mm", "B tracked", "B ATE mm", "B - A mm"});
   for (const ResultsDiff::Row& row : diff.rows) {
     std::vector<std::string> cells = {row.key};

@@ -3,6 +3,7 @@
 // sequence and sweep point.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -27,6 +28,12 @@ struct ResultsDiff {
   // Runs in both that one evaluation did not track to the end (lost or failed).
   int short_only_a = 0, short_only_b = 0, short_both = 0;
   int only_in_a = 0, only_in_b = 0;
+  // What the runs both evaluations have were run with, where it differs (read from their
+  // config.json): "path: value in A → value in B" → how many runs, e.g. a --set given to one
+  // evaluation only. Runs whose config is missing or unreadable are counted apart.
+  std::map<std::string, int> option_changes;
+  int other_sequence = 0;            // runs of the same name on another sequence folder
+  int configs_unread = 0;
 };
 
 ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunResult>& b);
