@@ -491,7 +491,9 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
   EXPECT_EQ(diff.only_in_b, 1);
   std::stringstream table;
   PrintDiff(diff, "before", "after", table);
-  EXPECT_NE(table.str().find("A: before (code: not recorded)\nB: after (code: not recorded)"), std::string::npos);
+  EXPECT_NE(table.str().find("A: before (code: not recorded)\nB: after (code: not recorded)\n"
+                             "Options: no run both have records them"),
+            std::string::npos);
   EXPECT_NEAR(diff.b_against_a.GeometricMeanRatio(), std::cbrt(1.0003 * (2.0 / 3) * 1.25), 1e-12);
   for (const char* expected : {"1 / 1 / 1", "p = 1.000", "absent", "FAILED", "-1.000", "0.500",
                                "geometric mean over the runs: 0.941"}) {
@@ -531,7 +533,9 @@ TEST(Results, DiffNamesTheOptionsThatDifferBetweenTheRuns) {
   EXPECT_EQ(diff.configs_unread, 1);
   std::stringstream text;
   PrintDiff(diff, "A", "B", text);
-  for (const char* expected : {"Options that differ, A → B (runs):\n  deformation.k: 1.1 → 2.0 (2)\n",
+  EXPECT_EQ(diff.configs_compared, 3);
+  for (const char* expected : {"Options that differ over the 3 run(s) both have, A → B (runs):\n"
+                               "  deformation.k: 1.1 → 2.0 (2)\n",
                                "1 run(s) of the same name ran on another sequence folder",
                                "1 run(s) with a config.json that could not be read"}) {
     EXPECT_NE(text.str().find(expected), std::string::npos) << expected << "\n" << text.str();
@@ -542,7 +546,7 @@ TEST(Results, DiffNamesTheOptionsThatDifferBetweenTheRuns) {
   EXPECT_TRUE(same.option_changes.empty());
   std::stringstream same_text;
   PrintDiff(same, "A", "B", same_text);
-  EXPECT_NE(same_text.str().find("Options: the same in every run both have"), std::string::npos);
+  EXPECT_NE(same_text.str().find("Options: the same in all 1 run(s) both have"), std::string::npos);
   EXPECT_EQ(DiffResults({a[1]}, {b[1]}).option_changes.size(), 0u);
   std::filesystem::remove_all(folder);
 }

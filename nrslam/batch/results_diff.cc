@@ -41,6 +41,7 @@ void CountConfigChanges(const RunResult& a, const RunResult& b, ResultsDiff* dif
     return;
   }
   if (config_a.kind != RunConfig::kRead || config_b.kind != RunConfig::kRead) return;
+  ++diff->configs_compared;
   if (config_a.sequence != config_b.sequence) ++diff->other_sequence;
   // The same leaves in the same order both ways: "path=value in B" and "path=value in A".
   const std::vector<std::string> to_b = ChangedAssignments(config_a.options, config_b.options);
@@ -118,10 +119,13 @@ void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::st
   }
   out << "A: " << name_a << " (code: " << DescribeRevisions(revisions_a) << ")\nB: " << name_b
       << " (code: " << DescribeRevisions(revisions_b) << ")\n";
-  if (diff.option_changes.empty()) {
-    out << "Options: the same in every run both have\n";
+  const std::string compared = std::to_string(diff.configs_compared) + " run(s) both have";
+  if (diff.configs_compared == 0) {
+    out << "Options: no run both have records them\n";
+  } else if (diff.option_changes.empty()) {
+    out << "Options: the same in all " << compared << '\n';
   } else {
-    out << "Options that differ, A → B (runs):\n";
+    out << "Options that differ over the " << compared << ", A → B (runs):\n";
     for (const auto& [change, runs] : diff.option_changes) out << "  " << change << " (" << runs << ")\n";
   }
   if (diff.other_sequence > 0) out << diff.other_sequence << " run(s) of the same name ran on another sequence folder\n";

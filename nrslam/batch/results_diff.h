@@ -32,6 +32,7 @@ struct ResultsDiff {
   // config.json): "path: value in A → value in B" → how many runs, e.g. a --set given to one
   // evaluation only. Runs whose config is missing or unreadable are counted apart.
   std::map<std::string, int> option_changes;
+  int configs_compared = 0;          // runs in both whose two configs were read
   int other_sequence = 0;            // runs of the same name on another sequence folder
   int configs_unread = 0;
 };
