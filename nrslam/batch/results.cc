@@ -430,10 +430,10 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   std::map<std::string, const RunResult*> by_key;
   for (const RunResult& r : results) by_key[RunKey(r)] = &r;
   std::vector<std::string> baseline_revisions;
-  for (const auto& [key, expected] : runs.items()) baseline_revisions.push_back(expected.value("revision", ""));
   BaselineCheck check;
   TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
   for (const auto& [key, expected] : runs.items()) {
+    baseline_revisions.push_back(expected.value("revision", ""));
     const double rmse_before = expected.at("rmse_mm");
     const int tracked_before = expected.at("frames_tracked");
     const double allowed = rmse_before * (1.0 + tolerance.rmse_relative) + tolerance.rmse_absolute_mm;
