@@ -1,9 +1,19 @@
 # Script mode (cmake -P), run at every build by the nrslam_source_revision target: writes
-# OUTPUT from TEMPLATE with @revision@ = the git commit of SOURCE_DIR (12 hex digits), followed
-# by "-dirty-" and 8 hex digits of a hash of `git diff HEAD` when tracked files have uncommitted
-# changes (so two different sets of edits get different names); "unknown" outside a git
-# checkout or without git. configure_file rewrites OUTPUT only when its text changes, so an
-# unchanged tree rebuilds nothing.
+# OUTPUT from TEMPLATE with two names for the code being built.
+#
+# @revision@, for people: the git commit of SOURCE_DIR (12 hex digits), followed by "-dirty-"
+# and 8 hex digits of a hash of `git diff HEAD` when tracked files have uncommitted changes
+# (so two different sets of edits get different names); "unknown" outside a git checkout or
+# without git.
+#
+# @code_fingerprint@, for deciding whether a finished run can be reused: 12 hex digits of a
+# SHA-1 over the contents of every file that decides what a run computes (the library, the
+# tools, the build scripts) and over BUILD_FLAVOUR (compiler and flags). A commit that only
+# touches the README, the tests or a manifest keeps it, so it does not throw away finished
+# runs; it needs no git, so a copy of the sources without .git still resumes safely.
+#
+# configure_file rewrites OUTPUT only when its text changes, so an unchanged tree rebuilds
+# nothing.
 execute_process(COMMAND git -C "${SOURCE_DIR}" rev-parse --short=12 HEAD
                 OUTPUT_VARIABLE revision RESULT_VARIABLE failed OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
 if(failed OR revision STREQUAL "")
@@ -16,4 +26,19 @@ else()
     string(APPEND revision "-dirty-${changes_hash}")
   endif()
 endif()
+
+file(GLOB_RECURSE code_files LIST_DIRECTORIES false RELATIVE "${SOURCE_DIR}"
+     "${SOURCE_DIR}/nrslam/*.h" "${SOURCE_DIR}/nrslam/*.cc" "${SOURCE_DIR}/nrslam/*.in"
+     "${SOURCE_DIR}/nrslam/CMakeLists.txt" "${SOURCE_DIR}/tools/*.h" "${SOURCE_DIR}/tools/*.cc"
+     "${SOURCE_DIR}/tools/CMakeLists.txt" "${SOURCE_DIR}/cmake/*.cmake")
+list(APPEND code_files CMakeLists.txt)
+list(SORT code_files)
+set(code_listing "${BUILD_FLAVOUR}\n")
+foreach(code_file IN LISTS code_files)
+  file(SHA1 "${SOURCE_DIR}/${code_file}" file_hash)
+  string(APPEND code_listing "${code_file} ${file_hash}\n")
+endforeach()
+string(SHA1 code_fingerprint "${code_listing}")
+string(SUBSTRING "${code_fingerprint}" 0 12 code_fingerprint)
+
 configure_file("${TEMPLATE}" "${OUTPUT}" @ONLY)

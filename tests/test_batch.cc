@@ -1082,11 +1082,22 @@ TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
   lines.clear();
   ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   EXPECT_EQ(lines, std::vector<std::string>{"1 run(s) already finished, not run again"});
-  // A run made by other code (another commit, other uncommitted edits) is not reused either.
-  Json other_code = ReadJsonFile(plain.runs[0].run_folder / "config.json");
-  EXPECT_EQ(other_code.at("nrslam_revision"), SourceRevision());
-  other_code["nrslam_revision"] = std::string(SourceRevision()) + "-elsewhere";
+  // A run from another commit whose code is the same (a commit of the README alone) is reused...
+  const Json as_written = ReadJsonFile(plain.runs[0].run_folder / "config.json");
+  EXPECT_EQ(as_written.at("nrslam_revision"), SourceRevision());
+  EXPECT_EQ(as_written.at("nrslam_code"), CodeFingerprint());
+  Json other_commit = as_written;
+  other_commit["nrslam_revision"] = std::string(SourceRevision()) + "-elsewhere";
+  std::ofstream(plain.runs[0].run_folder / "config.json") << other_commit.dump();
+  EXPECT_TRUE(RunIsFinished(plain.runs[0]));
+  // ... one made by other code is not, nor one whose config does not say which code made it.
+  Json other_code = as_written;
+  other_code["nrslam_code"] = "0123456789ab";
   std::ofstream(plain.runs[0].run_folder / "config.json") << other_code.dump();
+  EXPECT_FALSE(RunIsFinished(plain.runs[0]));
+  Json unrecorded_code = as_written;
+  unrecorded_code.erase("nrslam_code");
+  std::ofstream(plain.runs[0].run_folder / "config.json") << unrecorded_code.dump();
   EXPECT_FALSE(RunIsFinished(plain.runs[0]));
   std::filesystem::remove_all(folder);
 }

@@ -456,6 +456,9 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   const std::string revision = config.at("nrslam_revision");
   EXPECT_EQ(revision, SourceRevision());
   EXPECT_TRUE(std::regex_match(revision, std::regex("[0-9a-f]{12}(-dirty-[0-9a-f]{8})?|unknown"))) << revision;
+  const std::string code = config.at("nrslam_code");
+  EXPECT_EQ(code, CodeFingerprint());
+  EXPECT_TRUE(std::regex_match(code, std::regex("[0-9a-f]{12}"))) << code;
   EXPECT_EQ(ReadTum(run / "trajectory.tum").size(), 40u);
   EXPECT_TRUE(fs::exists(run / "depth" / "000039.png"));
   std::ifstream metrics(run / "metrics.csv");

@@ -267,7 +267,8 @@ bool RunIsFinished(const RunJob& run) {
     // Parsed back through the options struct, so that a config written before an option
     // existed compares as that option's default.
     const Json options = OptionsFromJson<SystemOptions>(config.at("options"), "config.json");
-    const bool same_code = config.value("nrslam_revision", "") == SourceRevision();
+    // By the code's fingerprint, not its commit: a commit of documentation alone keeps the runs.
+    const bool same_code = config.value("nrslam_code", "") == CodeFingerprint();
     return options == run.options && same_sequence && same_code;
   } catch (const std::exception&) {
     return false;  // unreadable, or from a version with options this one lacks: run it again

@@ -79,9 +79,10 @@ std::string PrepareShellLine(const PrepareJob& prepare, const Programs& programs
 // The shell command of one run, self-contained: prepares its sequence first if needed.
 std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Programs& programs);
 
-// A run whose folder already holds a summary.json, and a config.json with this run's options
-// and sequence, finished before: it is not run again. A folder from other options (an --out
-// reused after changing --set or the manifest) is run again rather than reported stale.
+// A run whose folder already holds a summary.json, and a config.json with this run's options,
+// sequence and code fingerprint (CodeFingerprint()), finished before: it is not run again. A
+// folder from other options (an --out reused after changing --set or the manifest) or other
+// code is run again rather than reported stale.
 bool RunIsFinished(const RunJob& run);
 
 // Prepares what is missing, then runs what is not finished, `jobs` processes at a time.

@@ -72,6 +72,7 @@ RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::fil
   {
     nlohmann::json written{{"nrslam_version", NRSLAM_VERSION},
                            {"nrslam_revision", SourceRevision()},
+                           {"nrslam_code", CodeFingerprint()},
                            {"sequence", std::filesystem::absolute(sequence).string()}};
     written.update(config);
     std::ofstream file = OpenForWriting(out / "config.json");
