@@ -232,8 +232,38 @@ TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
   const Json from_recorded = MakeBaseline(recorded, BaselineTolerance{});
   EXPECT_EQ(from_recorded["runs"]["a"]["revision"], "0123456789ab");
   EXPECT_NE(CheckBaseline(before, from_recorded)
-                .report.find("code of the baseline: 0123456789ab, 0123456789ab-dirty-fedcba98; of these runs: not recorded"),
+                .report.find("code of the baseline: 0123456789ab, 0123456789ab-dirty-fedcba98; of these runs: not recorded\n"),
             std::string::npos);
+  // With code fingerprints on both sides it also says whether the code itself changed: another
+  // commit (here, one that changed only documentation) can hold the same code.
+  for (RunResult& r : recorded) r.code = "c0dec0dec0de";
+  std::vector<RunResult> later = recorded;
+  for (RunResult& r : later) r.revision = "fedcba987654";
+  const Json with_code = MakeBaseline(recorded, BaselineTolerance{});
+  EXPECT_EQ(with_code["runs"]["b"]["code"], "c0dec0dec0de");
+  EXPECT_NE(CheckBaseline(later, with_code).report.find("of these runs: fedcba987654 (the same code)\n"), std::string::npos)
+      << CheckBaseline(later, with_code).report;
+  later[1].code = "0123456789ab";
+  EXPECT_NE(CheckBaseline(later, with_code).report.find("of these runs: fedcba987654 (other code)\n"), std::string::npos);
+}
+
+TEST(Results, CodeIsTheSameOnlyWhenEveryRunRecordsOneFingerprint) {
+  EXPECT_EQ(CompareCode({"a", "a"}, {"a"}), "the same code");
+  EXPECT_EQ(CompareCode({"a", "a"}, {"a", "b"}), "other code");
+  EXPECT_EQ(CompareCode({"a"}, {"b"}), "other code");
+  EXPECT_EQ(CompareCode({"a", ""}, {"a"}), "");  // an older run: cannot tell
+  EXPECT_EQ(CompareCode({}, {"a"}), "");
+  RunResult run = Result("a", 1.0, 60);
+  run.code = "c0dec0dec0de";
+  EXPECT_EQ(ResultsFromJson(ToJson({run}))[0].code, "c0dec0dec0de");
+  EXPECT_TRUE(ToJson({Result("a", 1.0, 60)})["results"][0]["code"].is_null());
+  std::vector<RunResult> before = {run}, after = {run};
+  after[0].revision = "fedcba987654";
+  std::stringstream same;
+  PrintDiff(DiffResults(before, after), "before", "after", same);
+  EXPECT_NE(same.str().find("B: after (code: fedcba987654)\nA and B: the same code (by the code fingerprints of their runs)\n"),
+            std::string::npos)
+      << same.str();
 }
 
 TEST(Results, RevisionsAreListedOnceSortedWithTheUnrecordedLast) {
@@ -793,6 +823,7 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   EXPECT_DOUBLE_EQ(read[0].rmse_mm, results[0].rmse_mm);
   // Each run names the code that made it; the broken one never wrote a config.
   EXPECT_EQ(read[0].revision, SourceRevision());
+  EXPECT_EQ(read[0].code, CodeFingerprint());
   EXPECT_EQ(read[1].revision, "");
   EXPECT_EQ(DescribeRevisions(read), std::string(SourceRevision()) + ", not recorded");
   EXPECT_GT(results[0].rmse_flat_mm, 0.0);

@@ -197,6 +197,16 @@ std::string InitFrameCell(const RunResult& result) {
 
 std::string AteCell(double ate_mm) { return ate_mm >= 0 ? FormatFixed(ate_mm, 3) : "-"; }
 
+std::string CompareCode(const std::vector<std::string>& codes_a, const std::vector<std::string>& codes_b) {
+  const auto recorded = [](const std::vector<std::string>& codes) {
+    return !codes.empty() && std::none_of(codes.begin(), codes.end(), [](const std::string& c) { return c.empty(); });
+  };
+  if (!recorded(codes_a) || !recorded(codes_b)) return "";
+  std::set<std::string> distinct(codes_a.begin(), codes_a.end());
+  distinct.insert(codes_b.begin(), codes_b.end());
+  return distinct.size() == 1 ? "the same code" : "other code";
+}
+
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
   std::vector<RunResult> results;
   for (const RunJob& run : plan.runs) {
@@ -209,7 +219,9 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
       if (std::filesystem::exists(run.run_folder / "summary.json")) {
         ReadFigures(ReadJsonFile(run.run_folder / "summary.json"), &result);
         if (std::filesystem::exists(run.run_folder / "config.json")) {
-          result.revision = ReadJsonFile(run.run_folder / "config.json").value("nrslam_revision", "");
+          const Json config = ReadJsonFile(run.run_folder / "config.json");
+          result.revision = config.value("nrslam_revision", "");
+          result.code = config.value("nrslam_code", "");
         }
         result.status = result.init_frame < 0 ? "not_initialised"
                         : result.frames_tracked + result.init_frame >= result.frames_total ? "ok"
@@ -236,6 +248,7 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"rmse_flat_mm", r.rmse_flat_mm >= 0 ? Json(r.rmse_flat_mm) : Json()},
                     {"ate_rmse_mm", r.ate_mm >= 0 ? Json(r.ate_mm) : Json()}, {"fps", r.fps}, {"run_folder", r.run_folder},
                     {"revision", r.revision.empty() ? Json() : Json(r.revision)},
+                    {"code", r.code.empty() ? Json() : Json(r.code)},
                     {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
                     {"stop_reason", r.stop_reason.empty() ? Json() : Json(r.stop_reason)}});
   }
@@ -256,6 +269,8 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
       r.run_folder = row.value("run_folder", "");
       const auto revision = row.find("revision");
       if (revision != row.end() && revision->is_string()) r.revision = revision->get<std::string>();
+      const auto code = row.find("code");
+      if (code != row.end() && code->is_string()) r.code = code->get<std::string>();
       results.push_back(r);
     }
   } catch (const Json::exception& e) {
@@ -407,6 +422,7 @@ Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance
     if (r.status == "failed") continue;
     runs[RunKey(r)] = {{"rmse_mm", r.rmse_mm}, {"frames_tracked", r.frames_tracked}};
     if (!r.revision.empty()) runs[RunKey(r)]["revision"] = r.revision;
+    if (!r.code.empty()) runs[RunKey(r)]["code"] = r.code;
   }
   return {{"tolerance",
            {{"rmse_relative", tolerance.rmse_relative},
@@ -429,11 +445,13 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   }
   std::map<std::string, const RunResult*> by_key;
   for (const RunResult& r : results) by_key[RunKey(r)] = &r;
-  std::vector<std::string> baseline_revisions;
+  std::vector<std::string> baseline_revisions, baseline_codes, run_codes;
+  for (const RunResult& r : results) run_codes.push_back(r.code);
   BaselineCheck check;
   TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
   for (const auto& [key, expected] : runs.items()) {
     baseline_revisions.push_back(expected.value("revision", ""));
+    baseline_codes.push_back(expected.value("code", ""));
     const double rmse_before = expected.at("rmse_mm");
     const int tracked_before = expected.at("frames_tracked");
     const double allowed = rmse_before * (1.0 + tolerance.rmse_relative) + tolerance.rmse_absolute_mm;
@@ -462,8 +480,9 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   std::ostringstream report;
   report << "Baseline check (RMSE may grow by " << FormatFixed(100 * tolerance.rmse_relative, 0) << " % + "
          << tolerance.rmse_absolute_mm << " mm; frames tracked may drop by " << tolerance.frames_tracked << "):\n"
-         << "code of the baseline: " << DescribeRevisions(baseline_revisions) << "; of these runs: " << DescribeRevisions(results)
-         << '\n';
+         << "code of the baseline: " << DescribeRevisions(baseline_revisions) << "; of these runs: " << DescribeRevisions(results);
+  const std::string same_code = CompareCode(baseline_codes, run_codes);
+  report << (same_code.empty() ? "" : " (" + same_code + ")") << '\n';
   table.Print(report);
   report << (check.passed ? "PASSED" : "FAILED: at least one run is worse than the baseline allows") << '\n';
   check.report = report.str();

@@ -25,6 +25,7 @@ struct RunResult {
   double rmse_flat_mm = -1;         // what a map at one depth scores on the same points; negative: not recorded
   std::string run_folder;
   std::string revision;             // the code that made the run (its config.json); "" when not recorded
+  std::string code;                 // that code's fingerprint (CodeFingerprint()); "" when not recorded
   // A run that ends without tracking: from which frame, and why (the runner's note); for a run
   // that never initialised, frame -1 and the last frame's note. Empty when it ends tracking.
   int stop_frame = -1;
@@ -43,6 +44,11 @@ std::string RunKey(const RunResult& result);
 // and joined by ", ", e.g. "1a2b3c4d5e6f, not recorded": what code a set of results came from.
 std::string DescribeRevisions(const std::vector<std::string>& revisions);
 std::string DescribeRevisions(const std::vector<RunResult>& results);
+// Whether two sets of runs were made by the same code, by their code fingerprints
+// (RunResult::code): "the same code" when every run on both sides records one and the same
+// fingerprint (their commits may still differ, in documentation or tests), "other code" when
+// every run records one and they differ, "" when a run does not record one (older runs).
+std::string CompareCode(const std::vector<std::string>& codes_a, const std::vector<std::string>& codes_b);
 // Paired runs counted by how a run's RMSE compares with its partner's (the reference):
 // "same" when equal to the printed 0.001 mm.
 struct RmseChangeCounts {
