@@ -247,6 +247,26 @@ TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
   EXPECT_NE(CheckBaseline(later, with_code).report.find("of these runs: fedcba987654 (other code)\n"), std::string::npos);
 }
 
+TEST(Results, CsvNamesTheCodeOfEveryRun) {
+  const auto folder = UniqueTempFolder("results_csv");
+  RunResult recorded = Result("a", 1.5, 60);
+  recorded.revision = "0123456789ab";
+  recorded.code = "c0dec0dec0de";
+  RunResult failed = Result("b", 0, 0);
+  failed.status = "failed";
+  failed.error = "cannot read rgb/000003.png, corrupt";
+  WriteResults({recorded, failed}, folder);
+  std::ifstream csv(folder / "results.csv");
+  std::string header, first, second;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  std::getline(csv, second);
+  EXPECT_EQ(header.substr(header.rfind(",fps,")), ",fps,revision,code,error");
+  EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
+  EXPECT_EQ(second.substr(second.find(",,,\"")), ",,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
+  std::filesystem::remove_all(folder);
+}
+
 TEST(Results, CodeIsTheSameOnlyWhenEveryRunRecordsOneFingerprint) {
   EXPECT_EQ(CompareCode({"a", "a"}, {"a"}), "the same code");
   EXPECT_EQ(CompareCode({"a", "a"}, {"a", "b"}), "other code");

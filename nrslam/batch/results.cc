@@ -284,15 +284,14 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
-         "rmse_flat_mm,ate_rmse_mm,fps,error\n";
+         "rmse_flat_mm,ate_rmse_mm,fps,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',';
     if (r.rmse_flat_mm >= 0) csv << r.rmse_flat_mm;  // empty when not recorded
     csv << ',';
     if (r.ate_mm >= 0) csv << r.ate_mm;  // empty without a trajectory error
-    csv << ',' << r.fps
-        << ',' << CsvField(r.error) << '\n';
+    csv << ',' << r.fps << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
 }
 
