@@ -94,6 +94,33 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(Manifest, OnlyKeepsTheNamedSequencesInTheManifestsOrder) {
+  const auto folder = UniqueTempFolder("manifest_only");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({
+    "defaults": {"set": {"k": 2}},
+    "sequences": [{"name": "sim-3", "preset": "sim-3"}, {"name": "lap-lobes", "preset": "lap-lobes"},
+                  {"name": "sim-3-rigid", "preset": "sim-3", "rigid": true}]})"));
+  const auto names = [](const Manifest& m) {
+    std::vector<std::string> listed;
+    for (const ManifestSequence& s : m.sequences) listed.push_back(s.name);
+    return listed;
+  };
+  EXPECT_EQ(names(WithOnlySequences(manifest, {"sim-3*"})), (std::vector<std::string>{"sim-3", "sim-3-rigid"}));
+  const Manifest two = WithOnlySequences(manifest, {"sim-3-rigid", "lap-lobes"});
+  EXPECT_EQ(names(two), (std::vector<std::string>{"lap-lobes", "sim-3-rigid"}));
+  EXPECT_TRUE(two.sequences[1].rigid);  // each keeps its settings
+  EXPECT_EQ(two.sequences[1].assignments, manifest.sequences[2].assignments);
+  try {
+    WithOnlySequences(manifest, {"sim-3", "sim-9"});
+    ADD_FAILURE() << "a name the manifest lacks must be an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no sequence matches \"sim-9\"; it has sim-3, lap-lobes, sim-3-rigid"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(folder);
+}
+
 // Every shipped manifest of simulated sequences loads and plans with its options validated
 // (the dataset templates name paths on the user's disk and are tested by their importers).
 TEST(Manifest, ShippedSimulationManifestsAreValid) {

@@ -24,6 +24,7 @@
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
 
@@ -73,8 +74,11 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
 }
 
 // The manifest, with each preset once per scene seed when --seeds gives any.
-nrslam::Manifest LoadSeeded(const std::filesystem::path& file, const std::string& seeds) {
-  const nrslam::Manifest manifest = nrslam::LoadManifest(file);
+// The manifest's sequences (those --only names, if given), each once per --seeds seed.
+nrslam::Manifest LoadChosen(const std::filesystem::path& file, const std::vector<std::string>& only,
+                            const std::string& seeds) {
+  nrslam::Manifest manifest = nrslam::LoadManifest(file);
+  if (!only.empty()) manifest = nrslam::WithOnlySequences(manifest, only);
   return seeds.empty() ? manifest : nrslam::WithSceneSeeds(manifest, nrslam::ParseSeedList(seeds));
 }
 
@@ -105,7 +109,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(0, 1);
   std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline,
       config_path;
-  std::vector<std::string> assignments, sweeps;
+  std::vector<std::string> assignments, sweeps, only;
   std::string seeds;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   double tolerance = 0.10;
@@ -124,6 +128,9 @@ int main(int argc, char** argv) {
                                           "object): those that differ from the defaults, before --set");
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");
   app.add_option("--sweep", sweeps, "run a grid: --sweep k=0.5,1.1,2 --sweep max_degree_D=3,5,10");
+  app.add_option("--only", only,
+                 "evaluate only these sequences of the manifest: names or shell wildcards, e.g. --only sim-3 "
+                 "'lap-*' (before --seeds adds -seedN)");
   app.add_option("--seeds", seeds,
                  "render every preset of the manifest once per scene seed, e.g. --seeds 1-3 (names get -seedN; "
                  "the seed table summarises each preset over them)");
@@ -182,7 +189,7 @@ int main(int argc, char** argv) {
     for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
     if (merge->parsed()) {
       // Runs of the same plan executed elsewhere: gather their run folders under --out.
-      const nrslam::Manifest manifest = LoadSeeded(merge_manifest, seeds);
+      const nrslam::Manifest manifest = LoadChosen(merge_manifest, only, seeds);
       nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
       for (nrslam::RunJob& run : plan.runs) {
         for (const std::string& folder : merge_folders) {
@@ -194,7 +201,7 @@ int main(int argc, char** argv) {
       return Finish(plan, out, check_baseline, write_baseline, tolerance);
     }
     if (manifest_path.empty()) throw nrslam::Error("a manifest is required (see data_manifests/)");
-    const nrslam::Manifest manifest = LoadSeeded(manifest_path, seeds);
+    const nrslam::Manifest manifest = LoadChosen(manifest_path, only, seeds);
     const nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
     std::filesystem::create_directories(out);
     if (!emit_jobs.empty()) {
@@ -205,6 +212,7 @@ int main(int argc, char** argv) {
       if (!config_path.empty()) plan_options += " --config " + config_path;
       for (const std::string& a : assignments) plan_options += " --set " + a;
       for (const std::string& sweep : sweeps) plan_options += " --sweep " + sweep;
+      for (const std::string& pattern : only) plan_options += " --only " + nrslam::ShellLine({pattern});
       if (!seeds.empty()) plan_options += " --seeds " + seeds;
       std::cout << plan.runs.size() << " job(s) written to " << emit_jobs
                 << "; run them anywhere, then: nrslam_eval merge " << manifest_path << " --out " << out << plan_options

@@ -1,11 +1,14 @@
 #include "nrslam/batch/manifest.h"
 
+#include <fnmatch.h>
+
 #include <algorithm>
 #include <set>
 
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 
@@ -207,6 +210,28 @@ Manifest LoadManifest(const std::filesystem::path& file) {
     manifest.sequences.push_back(std::move(sequence));
   }
   return manifest;
+}
+
+Manifest WithOnlySequences(const Manifest& manifest, const std::vector<std::string>& patterns) {
+  const auto matches = [](const std::string& pattern, const std::string& name) {
+    return fnmatch(pattern.c_str(), name.c_str(), 0) == 0;
+  };
+  for (const std::string& pattern : patterns) {
+    if (std::none_of(manifest.sequences.begin(), manifest.sequences.end(),
+                     [&](const ManifestSequence& s) { return matches(pattern, s.name); })) {
+      std::vector<std::string> names;
+      for (const ManifestSequence& s : manifest.sequences) names.push_back(s.name);
+      throw Error(manifest.file.string() + ": no sequence matches \"" + pattern + "\"; it has " + Join(names, ", "));
+    }
+  }
+  Manifest chosen = manifest;
+  chosen.sequences.clear();
+  for (const ManifestSequence& s : manifest.sequences) {
+    if (std::any_of(patterns.begin(), patterns.end(), [&](const std::string& p) { return matches(p, s.name); })) {
+      chosen.sequences.push_back(s);
+    }
+  }
+  return chosen;
 }
 
 }  // namespace nrslam

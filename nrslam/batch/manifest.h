@@ -54,4 +54,10 @@ struct Manifest {
 // Throws Error naming the manifest, the sequence and what is wrong.
 Manifest LoadManifest(const std::filesystem::path& file);
 
+// The manifest with only the sequences whose names match one of `patterns`, in the manifest's
+// order. A pattern is a name or a shell wildcard ("sim-3*" is sim-3 and sim-3-rigid), so that
+// one sequence of a long list can be run again with all its manifest settings. Throws Error
+// when a pattern matches nothing, listing the names there are.
+Manifest WithOnlySequences(const Manifest& manifest, const std::vector<std::string>& patterns);
+
 }  // namespace nrslam
