@@ -114,8 +114,14 @@ ResultsDiff DiffResults(const std::vector<RunResult>& a, const std::vector<RunRe
 void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::string& name_b, std::ostream& out) {
   std::vector<std::string> revisions_a, revisions_b, codes_a, codes_b;
   for (const ResultsDiff::Row& row : diff.rows) {
-    if (row.a) revisions_a.push_back(row.a->revision), codes_a.push_back(row.a->code);
-    if (row.b) revisions_b.push_back(row.b->revision), codes_b.push_back(row.b->code);
+    if (row.a) {
+      revisions_a.push_back(row.a->revision);
+      codes_a.push_back(row.a->code);
+    }
+    if (row.b) {
+      revisions_b.push_back(row.b->revision);
+      codes_b.push_back(row.b->code);
+    }
   }
   out << "A: " << name_a << " (code: " << DescribeRevisions(revisions_a) << ")\nB: " << name_b
       << " (code: " << DescribeRevisions(revisions_b) << ")\n";
