@@ -8,7 +8,8 @@
 #
 # @code_fingerprint@, for deciding whether a finished run can be reused: 12 hex digits of a
 # SHA-1 over the contents of every file that decides what a run computes (the library, the
-# tools, the build scripts) and over BUILD_FLAVOUR (compiler and flags). A commit that only
+# tools, the build scripts) and over BUILD_FLAVOUR (compiler, flags, and the versions of Eigen,
+# Ceres, OpenCV and Embree). A commit that only
 # touches the README, the tests or a manifest keeps it, so it does not throw away finished
 # runs; it needs no git, so a copy of the sources without .git still resumes safely.
 #

@@ -12,10 +12,10 @@ namespace nrslam {
 const char* SourceRevision();
 
 // 12 hex digits of a hash of the contents of the library's, the tools' and the build's source
-// files and of the compiler and its flags (cmake/WriteSourceRevision.cmake). Two builds with
-// the same fingerprint against the same system libraries (Ceres, OpenCV, Eigen: Debian's)
-// compute the same figures, whatever else differs between their commits (README, tests,
-// manifests), so a finished run is reused exactly when it matches.
+// files, of the compiler and its flags, and of the versions of Eigen, Ceres, OpenCV and Embree
+// (cmake/WriteSourceRevision.cmake). Two builds with the same fingerprint compute the same
+// figures, whatever else differs between their commits (README, tests, manifests), so a
+// finished run is reused exactly when it matches.
 const char* CodeFingerprint();
 
 // "nrslam <version> (revision <SourceRevision()>, code <CodeFingerprint()>)": what the tools
