@@ -9,9 +9,9 @@
 # @code_fingerprint@, for deciding whether a finished run can be reused: 12 hex digits of a
 # SHA-1 over the contents of every file that decides what a run computes (the library, the
 # tools, the build scripts) and over BUILD_FLAVOUR (compiler, flags, and the versions of Eigen,
-# Ceres, OpenCV and Embree). A commit that only
-# touches the README, the tests or a manifest keeps it, so it does not throw away finished
-# runs; it needs no git, so a copy of the sources without .git still resumes safely.
+# Ceres, OpenCV and Embree). A commit that only touches the README, the tests or a manifest
+# keeps it, so it does not throw away finished runs; it needs no git, so a copy of the sources
+# without .git still resumes safely.
 #
 # configure_file rewrites OUTPUT only when its text changes, so an unchanged tree rebuilds
 # nothing.
