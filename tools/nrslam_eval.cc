@@ -73,7 +73,6 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   return code;
 }
 
-// The manifest, with each preset once per scene seed when --seeds gives any.
 // The manifest's sequences (those --only names, if given), each once per --seeds seed.
 nrslam::Manifest LoadChosen(const std::filesystem::path& file, const std::vector<std::string>& only,
                             const std::string& seeds) {
@@ -207,16 +206,19 @@ int main(int argc, char** argv) {
     if (!emit_jobs.empty()) {
       std::ofstream file(emit_jobs);
       for (const nrslam::RunJob& run : plan.runs) file << nrslam::RunShellLine(plan, run, programs) << '\n';
-      // merge must plan the same runs, so it is given every option that shapes the plan.
-      std::string plan_options;
-      if (!config_path.empty()) plan_options += " --config " + config_path;
-      for (const std::string& a : assignments) plan_options += " --set " + a;
-      for (const std::string& sweep : sweeps) plan_options += " --sweep " + sweep;
-      for (const std::string& pattern : only) plan_options += " --only " + nrslam::ShellLine({pattern});
-      if (!seeds.empty()) plan_options += " --seeds " + seeds;
-      std::cout << plan.runs.size() << " job(s) written to " << emit_jobs
-                << "; run them anywhere, then: nrslam_eval merge " << manifest_path << " --out " << out << plan_options
-                << '\n';
+      // merge must plan the same runs, so it is given every option that shapes the plan, quoted
+      // as the shell needs (a wildcard of --only, a value with spaces).
+      std::vector<std::string> merge_command = {"nrslam_eval", "merge", manifest_path, "--out", out};
+      const auto add = [&](const std::string& flag, const std::vector<std::string>& values) {
+        for (const std::string& value : values) merge_command.insert(merge_command.end(), {flag, value});
+      };
+      if (!config_path.empty()) add("--config", {config_path});
+      add("--set", assignments);
+      add("--sweep", sweeps);
+      add("--only", only);
+      if (!seeds.empty()) add("--seeds", {seeds});
+      std::cout << plan.runs.size() << " job(s) written to " << emit_jobs << "; run them anywhere, then: "
+                << nrslam::ShellLine(merge_command) << '\n';
       return 0;
     }
     std::cerr << manifest.sequences.size() << " sequence(s), " << plan.runs.size() << " run(s), " << jobs

@@ -216,19 +216,21 @@ Manifest WithOnlySequences(const Manifest& manifest, const std::vector<std::stri
   const auto matches = [](const std::string& pattern, const std::string& name) {
     return fnmatch(pattern.c_str(), name.c_str(), 0) == 0;
   };
-  for (const std::string& pattern : patterns) {
-    if (std::none_of(manifest.sequences.begin(), manifest.sequences.end(),
-                     [&](const ManifestSequence& s) { return matches(pattern, s.name); })) {
-      std::vector<std::string> names;
-      for (const ManifestSequence& s : manifest.sequences) names.push_back(s.name);
-      throw Error(manifest.file.string() + ": no sequence matches \"" + pattern + "\"; it has " + Join(names, ", "));
-    }
-  }
   Manifest chosen = manifest;
   chosen.sequences.clear();
+  std::vector<bool> used(patterns.size(), false);
+  std::vector<std::string> names;
   for (const ManifestSequence& s : manifest.sequences) {
-    if (std::any_of(patterns.begin(), patterns.end(), [&](const std::string& p) { return matches(p, s.name); })) {
-      chosen.sequences.push_back(s);
+    names.push_back(s.name);
+    bool wanted = false;
+    for (size_t p = 0; p < patterns.size(); ++p) {
+      if (matches(patterns[p], s.name)) used[p] = wanted = true;
+    }
+    if (wanted) chosen.sequences.push_back(s);
+  }
+  for (size_t p = 0; p < patterns.size(); ++p) {
+    if (!used[p]) {
+      throw Error(manifest.file.string() + ": no sequence matches \"" + patterns[p] + "\"; it has " + Join(names, ", "));
     }
   }
   return chosen;
