@@ -3,6 +3,7 @@
 
 #include "nrslam/eval/common_points.h"
 #include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/eval/error_view.h"
 #include "nrslam/util/error.h"
 
 namespace nrslam {
@@ -195,6 +196,77 @@ TEST(CommonPoints, AnIdThatNamesDifferentTracksInTheTwoRunsIsNotCommon) {
   EXPECT_NEAR(comparison.a_common.rmse_mm, 0.0, 1e-9);
   EXPECT_NEAR(comparison.b_common.rmse_mm, 0.0, 1e-9);
   EXPECT_GT(comparison.a_own.rmse_mm, 1.0);
+}
+
+// A 80×60 frame of grey at 50 mm, with no depth on its first 10 columns. 40 points at z = 5
+// fix the scale at 10 (the two off ones fall in the trimmed 5 %).
+class ErrorViewTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    depth_.colRange(0, 10).setTo(0.0f);
+    int64_t id = 0;
+    for (int y = 5; y <= 55; y += 10) {
+      for (int x = 15; x <= 75; x += 10) points_[id++] = {cv::Point2d(x, y), 5.0};
+    }
+    points_[kTooDeep].depth = 6.5;     // 65 mm after scaling: 30 % too deep
+    points_[kTooShallow].depth = 3.5;  // 35 mm: 30 % too shallow
+    points_[kNoTruth] = {cv::Point2d(4.25, 30.5), 5.0};
+  }
+  static constexpr int64_t kTooDeep = 8, kTooShallow = 20, kRight = 30, kNoTruth = 100;
+  cv::Vec3b At(const cv::Mat& image, int64_t id, int panel_offset = 0) const {
+    const cv::Point2d pixel = points_.at(id).pixel;
+    return image.at<cv::Vec3b>(static_cast<int>(std::lround(pixel.y)),
+                               static_cast<int>(std::lround(pixel.x)) + panel_offset);
+  }
+  const cv::Mat bgr_ = cv::Mat(60, 80, CV_8UC3, cv::Scalar::all(100));
+  cv::Mat depth_ = cv::Mat(60, 80, CV_32F, cv::Scalar(50.0));
+  FramePoints points_;
+};
+
+TEST_F(ErrorViewTest, EachPointIsColouredByItsScaledDepthError) {
+  const ErrorView view = DrawErrorView(bgr_, depth_, points_, EvaluationOptions(), ErrorViewOptions());
+  std::vector<DepthPoint> all;
+  for (const auto& [id, point] : points_) all.push_back(point);
+  const FrameEvaluation expected = EvaluateFrame(all, depth_, EvaluationOptions());
+  ASSERT_TRUE(view.evaluation.evaluated);
+  EXPECT_DOUBLE_EQ(view.evaluation.scale, expected.scale);
+  EXPECT_DOUBLE_EQ(view.evaluation.rmse_mm, expected.rmse_mm);
+  EXPECT_NEAR(view.evaluation.scale, 10.0, 1e-12);
+  EXPECT_EQ(view.evaluation.points_without_groundtruth, 1);
+
+  ASSERT_EQ(view.image.size(), cv::Size(160, 60));  // colour | depth
+  EXPECT_EQ(At(view.image, kRight), cv::Vec3b(255, 255, 255));
+  EXPECT_EQ(At(view.image, kTooDeep), cv::Vec3b(0, 0, 255));     // BGR: red
+  EXPECT_EQ(At(view.image, kTooShallow), cv::Vec3b(255, 0, 0));  // blue
+  EXPECT_EQ(At(view.image, kNoTruth), cv::Vec3b(100, 100, 100)) << "a ring leaves the pixel under it visible";
+
+  // Depth panel: a right point has the background's colour, a wrong one does not.
+  const cv::Vec3b background = ColourDepth(depth_, 10, 120).at<cv::Vec3b>(30, 50);
+  EXPECT_EQ(view.image.at<cv::Vec3b>(0, 80 + 10), background);
+  EXPECT_EQ(At(view.image, kRight, 80), background);
+  EXPECT_EQ(At(view.image, kTooDeep, 80), ColourDepth(cv::Mat(1, 1, CV_32F, cv::Scalar(65.0)), 10, 120).at<cv::Vec3b>(0, 0));
+  EXPECT_NE(At(view.image, kTooDeep, 80), background);
+  EXPECT_EQ(At(view.image, kNoTruth, 80), cv::Vec3b(0, 0, 0)) << "no depth there: black, and no point drawn";
+}
+
+TEST_F(ErrorViewTest, WithoutAScaleNothingIsScored) {
+  const ErrorView no_depth = DrawErrorView(bgr_, cv::Mat(), points_, EvaluationOptions(), ErrorViewOptions());
+  EXPECT_FALSE(no_depth.evaluation.evaluated);
+  ASSERT_EQ(no_depth.image.size(), bgr_.size());
+  EXPECT_EQ(At(no_depth.image, kRight), cv::Vec3b(100, 100, 100));
+
+  EvaluationOptions needs_more;
+  needs_more.min_points = 100;
+  const ErrorView too_few = DrawErrorView(bgr_, depth_, points_, needs_more, ErrorViewOptions());
+  EXPECT_FALSE(too_few.evaluation.evaluated);
+  EXPECT_EQ(At(too_few.image, kTooDeep), cv::Vec3b(100, 100, 100));
+  EXPECT_EQ(At(too_few.image, kTooDeep, 80), ColourDepth(depth_, 10, 120).at<cv::Vec3b>(30, 50));
+
+  EXPECT_THROW(DrawErrorView(bgr_, depth_.colRange(0, 40).clone(), points_, EvaluationOptions(), ErrorViewOptions()),
+               Error);
+  ErrorViewOptions inverted;
+  inverted.far_mm = 5;
+  EXPECT_THROW(DrawErrorView(bgr_, depth_, points_, EvaluationOptions(), inverted), Error);
 }
 
 }  // namespace

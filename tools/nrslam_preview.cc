@@ -1,42 +1,163 @@
-// nrslam_preview: writes one frame of a sequence as a PNG — the colour image beside its
-// ground-truth depth in false colour (near = red, far = blue, black = none).
+// nrslam_preview: writes one frame of a sequence as a PNG: the colour image beside its
+// ground-truth depth in false colour (near = red, far = blue, black = none). With --run, the
+// run's points on that frame are drawn over both panels, coloured by their depth error, with
+// the frame's state and RMSE above.
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
+#include <map>
+#include <string>
+#include <vector>
 
+#include "nrslam/batch/run_folder.h"
+#include "nrslam/eval/error_view.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_table.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The state the run recorded for each frame (metrics.csv); none when it has no such file.
+std::map<int, std::string> RecordedStates(const fs::path& run) {
+  std::map<int, std::string> states;
+  if (!fs::exists(run / "metrics.csv")) return states;
+  for (const auto& row : nrslam::ReadCsv(run / "metrics.csv")) {
+    const double frame = nrslam::Number(row, "frame");
+    if (std::isfinite(frame) && row.count("state")) states[static_cast<int>(frame)] = row.at("state");
+  }
+  return states;
+}
+
+std::vector<std::string> Caption(const std::string& run_name, int frame, const std::string& state,
+                                 const nrslam::FramePoints& points, const nrslam::ErrorView& view, double full_scale) {
+  using nrslam::FormatFixed;
+  std::string first = run_name + "  frame " + std::to_string(frame);
+  if (!state.empty()) first += "  " + state;
+  first += "  " + std::to_string(points.size()) + " points";
+  const nrslam::FrameEvaluation& evaluation = view.evaluation;
+  if (evaluation.evaluated) {
+    first += "  RMSE " + FormatFixed(evaluation.rmse_mm, 2) + " mm (flat map " + FormatFixed(evaluation.flat_rmse_mm, 2) +
+             ")  scale " + FormatFixed(evaluation.scale, 3);
+  }
+  const std::string percent = FormatFixed(100 * full_scale, 0);
+  return {first, "depth error: blue " + percent + " % too shallow, white right, red " + percent +
+                     " % too deep; grey ring: not scored"};
+}
+
+cv::Mat WithCaption(const cv::Mat& image, const std::vector<std::string>& lines) {
+  constexpr int kLineHeight = 20;
+  cv::Mat out(image.rows + kLineHeight * static_cast<int>(lines.size()) + 6, image.cols, CV_8UC3, cv::Scalar::all(0));
+  image.copyTo(out(cv::Rect(0, out.rows - image.rows, image.cols, image.rows)));
+  for (size_t i = 0; i < lines.size(); ++i) {
+    // Small enough to fit a narrow (scaled-down) image.
+    int baseline = 0;
+    const double width = cv::getTextSize(lines[i], cv::FONT_HERSHEY_SIMPLEX, 1.0, 1, &baseline).width;
+    const double font_scale = std::min(0.45, (image.cols - 12) / width);
+    cv::putText(out, lines[i], cv::Point(6, kLineHeight * static_cast<int>(i + 1)), cv::FONT_HERSHEY_SIMPLEX,
+                font_scale, cv::Scalar::all(255), 1, cv::LINE_AA);
+  }
+  return out;
+}
+
+// A sequence, and optionally a run of it read once, drawn frame by frame.
+class Preview {
+ public:
+  Preview(const std::string& sequence, const std::string& run, const nrslam::ErrorViewOptions& options, double scale)
+      : reader_(sequence), run_(run), options_(options), scale_(scale) {
+    if (run_.empty()) return;
+    run_points_ = nrslam::ReadRunPoints(run_);
+    states_ = RecordedStates(run_);
+    evaluation_ = nrslam::RunEvaluationOptions(run_);
+  }
+
+  int frame_count() const { return reader_.frame_count(); }
+
+  cv::Mat Draw(int frame) const {
+    const cv::Mat colour = reader_.ReadRgb(frame);
+    const cv::Mat depth = reader_.has_depth() ? reader_.ReadDepthMm(frame) : cv::Mat();
+    std::vector<std::string> caption;
+    cv::Mat panel = colour;
+    if (!run_.empty()) {
+      const auto found = run_points_.find(frame);
+      const nrslam::FramePoints points = found == run_points_.end() ? nrslam::FramePoints() : found->second;
+      const nrslam::ErrorView view = nrslam::DrawErrorView(colour, depth, points, evaluation_, options_);
+      panel = view.image;
+      const auto state = states_.find(frame);
+      caption = Caption(run_.lexically_normal().filename().string(), frame, state == states_.end() ? "" : state->second,
+                        points, view, options_.full_scale_error);
+    } else if (!depth.empty()) {
+      cv::hconcat(colour, nrslam::ColourDepth(depth, options_.near_mm, options_.far_mm), panel);
+    }
+    if (scale_ != 1.0) cv::resize(panel, panel, cv::Size(), scale_, scale_, scale_ < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    return caption.empty() ? panel : WithCaption(panel, caption);
+  }
+
+ private:
+  nrslam::SequenceReader reader_;
+  fs::path run_;
+  nrslam::ErrorViewOptions options_;
+  double scale_;
+  nrslam::RunPoints run_points_;
+  std::map<int, std::string> states_;
+  nrslam::EvaluationOptions evaluation_;
+};
+
+void WritePng(const fs::path& file, const cv::Mat& image) {
+  if (!cv::imwrite(file.string(), image)) throw nrslam::Error("cannot write " + file.string());
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Write a frame of a sequence (colour | depth) as a PNG."};
+  CLI::App app{"Write a frame of a sequence (colour | depth) as a PNG; with --run, the run's points coloured by their "
+               "depth error"};
   app.set_version_flag("--version", nrslam::VersionString());
-  std::string sequence, out;
+  std::string sequence, run, out;
   int frame = 0;
-  double scale = 1.0, near_mm = 10.0, far_mm = 120.0;
-  app.add_option("sequence", sequence, "sequence folder")->required();
+  bool all_frames = false;
+  nrslam::ErrorViewOptions view_options;
+  double scale = 1.0;
+  app.add_option("sequence", sequence, "sequence folder (with --run: the run's own, from its config.json, if not given)");
+  app.add_option("--run", run, "a run folder of nrslam_run or nrslam_eval: draw its points of the frame");
   app.add_option("--frame", frame, "frame index")->capture_default_str();
-  app.add_option("--out", out, "output PNG")->required();
+  app.add_flag("--all", all_frames, "every frame, as OUT/NNNNNN.png (--out is then a folder)");
+  app.add_option("--out", out, "output PNG (with --all: a folder)")->required();
   app.add_option("--scale", scale, "resize factor")->capture_default_str();
-  app.add_option("--near", near_mm, "depth shown red, mm")->capture_default_str();
-  app.add_option("--far", far_mm, "depth shown blue, mm")->capture_default_str();
+  app.add_option("--near", view_options.near_mm, "depth shown red, mm")->capture_default_str();
+  app.add_option("--far", view_options.far_mm, "depth shown blue, mm")->capture_default_str();
+  app.add_option("--full-scale-error", view_options.full_scale_error,
+                 "relative depth error drawn at full colour (0.25 = 25 %)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
-    const nrslam::SequenceReader reader(sequence);
-    cv::Mat panel = reader.ReadRgb(frame);
-    if (reader.has_depth()) {
-      const cv::Mat depth = reader.ReadDepthMm(frame);
-      cv::Mat level;
-      depth.convertTo(level, CV_8U, -255.0 / (far_mm - near_mm), 255.0 * far_mm / (far_mm - near_mm));
-      cv::Mat coloured;
-      cv::applyColorMap(level, coloured, cv::COLORMAP_TURBO);
-      coloured.setTo(cv::Scalar::all(0), depth <= 0);
-      cv::hconcat(panel, coloured, panel);
+    view_options.Check();
+    if (!(scale > 0)) throw nrslam::Error("--scale must be > 0");
+    if (sequence.empty()) {
+      if (run.empty()) throw nrslam::Error("give a sequence folder, or --run with a run folder");
+      sequence = nrslam::ReadJsonFile(fs::path(run) / "config.json").at("sequence").get<std::string>();
     }
-    if (scale != 1.0) cv::resize(panel, panel, cv::Size(), scale, scale, cv::INTER_AREA);
-    if (!cv::imwrite(out, panel)) throw nrslam::Error("cannot write " + out);
+    const Preview preview(sequence, run, view_options, scale);
+    if (!all_frames) {
+      WritePng(out, preview.Draw(frame));
+      return 0;
+    }
+    fs::create_directories(out);
+    for (int index = 0; index < preview.frame_count(); ++index) {
+      char name[16];
+      std::snprintf(name, sizeof(name), "%06d.png", index);
+      WritePng(fs::path(out) / name, preview.Draw(index));
+    }
+    std::cout << "wrote " << preview.frame_count() << " frames to " << out << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_preview: " << e.what() << '\n';
     return 1;

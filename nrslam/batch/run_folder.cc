@@ -56,6 +56,13 @@ RunPoints ReadRunPoints(const std::filesystem::path& run_folder) {
   return points;
 }
 
+EvaluationOptions RunEvaluationOptions(const std::filesystem::path& run_folder) {
+  const std::string where = (run_folder / "config.json").string();
+  const Json config = ReadJsonFile(run_folder / "config.json");
+  return config.contains("options") ? OptionsFromJson<SystemOptions>(config.at("options"), where).evaluation
+                                    : OptionsFromJson<EvaluationOptions>(config.value("evaluation", Json::object()), where);
+}
+
 CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const std::filesystem::path& b) {
   const Json config = ReadJsonFile(a / "config.json");
   const Json other_config = ReadJsonFile(b / "config.json");
@@ -71,13 +78,9 @@ CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const s
   if (other != sequence) throw Error("the runs are of different sequences: " + sequence + " and " + other);
   const SequenceReader reader(sequence);
   if (!reader.has_depth()) throw Error("sequence " + sequence + " has no depth to compare against");
-  // Scored as run a scored itself: a run of ours by its options, an external result by its own.
-  const std::string where = (a / "config.json").string();
-  const EvaluationOptions evaluation =
-      config.contains("options") ? OptionsFromJson<SystemOptions>(config.at("options"), where).evaluation
-                                 : OptionsFromJson<EvaluationOptions>(config.value("evaluation", Json::object()), where);
+  // Scored as run a scored itself.
   return CompareOnCommonPoints(ReadRunPoints(a), ReadRunPoints(b), [&](int frame) { return reader.ReadDepthMm(frame); },
-                               evaluation);
+                               RunEvaluationOptions(a));
 }
 
 }  // namespace nrslam

@@ -19,6 +19,10 @@ double Number(const std::map<std::string, std::string>& row, const std::string& 
 // points.csv as pixels and estimated depths per frame.
 RunPoints ReadRunPoints(const std::filesystem::path& run_folder);
 
+// The evaluation options the run was scored with (config.json): a run of ours by its options,
+// an external result by its own.
+EvaluationOptions RunEvaluationOptions(const std::filesystem::path& run_folder);
+
 // Both runs must be of the same sequence (their config.json says which) and it must have
 // depth. Throws Error otherwise.
 CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const std::filesystem::path& b);
