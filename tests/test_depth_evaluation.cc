@@ -1,6 +1,8 @@
 // Known-answer tests of the evaluator (design README §5).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "nrslam/eval/common_points.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/eval/error_view.h"
@@ -247,6 +249,14 @@ TEST_F(ErrorViewTest, EachPointIsColouredByItsScaledDepthError) {
   EXPECT_EQ(At(view.image, kTooDeep, 80), ColourDepth(cv::Mat(1, 1, CV_32F, cv::Scalar(65.0)), 10, 120).at<cv::Vec3b>(0, 0));
   EXPECT_NE(At(view.image, kTooDeep, 80), background);
   EXPECT_EQ(At(view.image, kNoTruth, 80), cv::Vec3b(0, 0, 0)) << "no depth there: black, and no point drawn";
+  EXPECT_DOUBLE_EQ(view.full_scale_error, 0.25);
+
+  // Full colour from the frame's own errors: three times their rms over the 42 scored points.
+  ErrorViewOptions automatic;
+  automatic.full_scale_error = 0;
+  const ErrorView scaled = DrawErrorView(bgr_, depth_, points_, EvaluationOptions(), automatic);
+  EXPECT_NEAR(scaled.full_scale_error, 3 * std::sqrt(2 * 0.3 * 0.3 / 42), 1e-12);
+  EXPECT_EQ(At(scaled.image, kTooDeep), cv::Vec3b(0, 0, 255));
 }
 
 TEST_F(ErrorViewTest, WithoutAScaleNothingIsScored) {

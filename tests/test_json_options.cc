@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "nrslam/mapping/mapping_options.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/tracking/tracking_options.h"
 #include "nrslam/util/json_options.h"
+#include "temp_folder.h"
 
 namespace nrslam {
 namespace {
@@ -98,6 +101,24 @@ TEST(JsonOptions, DeformableGateSpanOptionsAreValidated) {
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_gate_span=longest"}), Error);
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"shortest_gate_below_fraction=1.5"}), Error);
   EXPECT_EQ(WithAssignments(MappingOptions{}, {"shortest_gate_below_fraction=0"}).shortest_gate_below_fraction, 0.0);
+}
+
+TEST(JsonOptions, AFileThatIsNotJsonIsNamedWithWhatIsWrong) {
+  const auto folder = UniqueTempFolder("json_file");
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "bad.json") << "{\"k\": ";
+  const auto message = [](const std::filesystem::path& file) {
+    try {
+      ReadJsonFile(file);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(folder), folder.string() + " is a folder, not a JSON file");
+  EXPECT_EQ(message(folder / "none.json"), "cannot open " + (folder / "none.json").string());
+  EXPECT_EQ(message(folder / "bad.json").rfind((folder / "bad.json").string() + " is not valid JSON (", 0), 0u);
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ std::map<int, std::string> RecordedStates(const fs::path& run) {
 }
 
 std::vector<std::string> Caption(const std::string& run_name, int frame, const std::string& state,
-                                 const nrslam::FramePoints& points, const nrslam::ErrorView& view, double full_scale) {
+                                 const nrslam::FramePoints& points, const nrslam::ErrorView& view) {
   using nrslam::FormatFixed;
   std::string first = run_name + "  frame " + std::to_string(frame);
   if (!state.empty()) first += "  " + state;
@@ -49,7 +49,7 @@ std::vector<std::string> Caption(const std::string& run_name, int frame, const s
     first += "  RMSE " + FormatFixed(evaluation.rmse_mm, 2) + " mm (flat map " + FormatFixed(evaluation.flat_rmse_mm, 2) +
              ")  scale " + FormatFixed(evaluation.scale, 3);
   }
-  const std::string percent = FormatFixed(100 * full_scale, 0);
+  const std::string percent = FormatFixed(100 * view.full_scale_error, view.full_scale_error < 0.1 ? 1 : 0);
   return {first, "depth error: blue " + percent + " % too shallow, white right, red " + percent +
                      " % too deep; grey ring: not scored"};
 }
@@ -94,7 +94,7 @@ class Preview {
       panel = view.image;
       const auto state = states_.find(frame);
       caption = Caption(run_.lexically_normal().filename().string(), frame, state == states_.end() ? "" : state->second,
-                        points, view, options_.full_scale_error);
+                        points, view);
     } else if (!depth.empty()) {
       cv::hconcat(colour, nrslam::ColourDepth(depth, options_.near_mm, options_.far_mm), panel);
     }
@@ -136,7 +136,8 @@ int main(int argc, char** argv) {
   app.add_option("--near", view_options.near_mm, "depth shown red, mm")->capture_default_str();
   app.add_option("--far", view_options.far_mm, "depth shown blue, mm")->capture_default_str();
   app.add_option("--full-scale-error", view_options.full_scale_error,
-                 "relative depth error drawn at full colour (0.25 = 25 %)")
+                 "relative depth error drawn at full colour (0.25 = 25 %); 0: three times each frame's rms relative "
+                 "error")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {

@@ -1,7 +1,6 @@
 #include "nrslam/batch/report.h"
 
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <fstream>
 #include <map>
@@ -11,6 +10,7 @@
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/svg_plot.h"
 #include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/eval/error_view.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/text_table.h"
 
@@ -54,21 +54,6 @@ Trajectories TopView(const std::filesystem::path& estimate_file, const std::vect
   return plot;
 }
 
-// The frame with each evaluated point drawn in its depth error, green (0) to red (≥ `full_mm`).
-cv::Mat DepthErrorImage(const SequenceReader& sequence, int frame, double scale, const FramePoints& points,
-                        double full_mm) {
-  cv::Mat image = sequence.ReadRgb(frame) * 0.6;
-  const cv::Mat depth = sequence.ReadDepthMm(frame);
-  for (const auto& [id, point] : points) {
-    const auto truth = SampleDepth(depth, point.pixel);
-    if (!truth) continue;
-    const double error = std::min(1.0, std::abs(scale * point.depth - *truth) / full_mm);
-    const cv::Scalar colour(0, 255 * (1.0 - error), 255 * error);  // BGR
-    cv::circle(image, cv::Point(cvRound(point.pixel.x), cvRound(point.pixel.y)), 3, colour, cv::FILLED, cv::LINE_AA);
-  }
-  return image;
-}
-
 // One run's section: plots and images, or why they are missing.
 std::string RunSection(const RunResult& result, const std::filesystem::path& folder) {
   std::ostringstream html;
@@ -89,7 +74,6 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
     const auto metrics = ReadCsv(run / "metrics.csv");
     PlotSeries rmse{"depth RMSE", "#1f77b4", {}, {}};
     PlotSeries flat{"a map at one depth", "#999999", {}, {}};  // runs before it was recorded have none
-    std::map<int, double> scales;
     std::vector<int> tracked;
     for (const auto& row : metrics) {
       if (row.at("state") != "tracking") continue;
@@ -100,7 +84,6 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
         flat.x.push_back(frame);
         flat.y.push_back(Number(row, "rmse_flat_mm"));
       }
-      scales[frame] = Number(row, "scale");
       tracked.push_back(frame);
     }
     html << "<div class=\"plots\">"
@@ -115,14 +98,23 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
       // The first frame after initialisation, the middle one and the last tracked one.
       const std::set<int> shown = {tracked[1], tracked[tracked.size() / 2], tracked.back()};
       RunPoints points = ReadRunPoints(run);
-      const double full_mm = std::max(1.0, 3.0 * result.rmse_mm);
-      html << "<p>Depth error of each tracked point, green = 0 to red ≥ " << FormatFixed(full_mm, 1)
-           << " mm:</p><div class=\"images\">";
+      const EvaluationOptions evaluation = RunEvaluationOptions(run);
+      ErrorViewOptions view_options;
+      view_options.full_scale_error = 0;  // from each frame's errors: depth-initialised runs are off by a few per cent
+      html << "<p>Depth error of each tracked point after the frame's scale: blue too shallow, white right, red too "
+              "deep (full colour at the per cent given); beside it the ground-truth depth, each point filled with the "
+              "colour of its own depth:</p><div class=\"images\">";
       for (int frame : shown) {
         const std::string name = Slug(result) + "_depth_error_" + std::to_string(frame) + ".png";
-        cv::imwrite((folder / name).string(), DepthErrorImage(sequence, frame, scales[frame], points[frame], full_mm));
-        html << "<figure><img src=\"" << EscapeXml(name) << "\" width=\"320\"><figcaption>frame " << frame
-             << "</figcaption></figure>";
+        const ErrorView view = DrawErrorView(sequence.ReadRgb(frame), sequence.ReadDepthMm(frame), points[frame],
+                                             evaluation, view_options);
+        cv::imwrite((folder / name).string(), view.image);
+        html << "<figure><img src=\"" << EscapeXml(name) << "\" width=\"640\"><figcaption>frame " << frame;
+        if (view.evaluation.evaluated) {
+          html << ", RMSE " << FormatFixed(view.evaluation.rmse_mm, 2) << " mm, full colour at ±"
+               << FormatFixed(100 * view.full_scale_error, 1) << " %";
+        }
+        html << "</figcaption></figure>";
       }
       html << "</div>\n";
     }

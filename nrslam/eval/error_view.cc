@@ -51,7 +51,7 @@ cv::Scalar DepthColour(double depth_mm, double near_mm, double far_mm) {
 
 void ErrorViewOptions::Check() const {
   CheckOption(near_mm >= 0 && far_mm > near_mm, "error view", "need 0 <= near_mm < far_mm");
-  CheckOption(full_scale_error > 0, "error view", "full_scale_error must be > 0");
+  CheckOption(full_scale_error >= 0, "error view", "full_scale_error must be >= 0 (0: from the frame's errors)");
   CheckOption(point_radius_px >= 1, "error view", "point_radius_px must be >= 1");
 }
 
@@ -79,18 +79,33 @@ ErrorView DrawErrorView(const cv::Mat& bgr, const cv::Mat& depth_mm, const Frame
     for (const auto& [id, point] : points) frame_points.push_back(point);
     view.evaluation = EvaluateFrame(frame_points, depth_mm, evaluation);
   }
+  // Without a scale nothing is scored, and a frame with a scale has depth to sample.
+  std::vector<double> truths;
+  double squared_relative_error = 0;
+  int scored = 0;
+  for (const auto& [id, point] : points) {
+    truths.push_back(view.evaluation.evaluated ? SampleDepth(depth_mm, point.pixel).value_or(kNoDepth) : kNoDepth);
+    if (std::isnan(truths.back()) || !std::isfinite(point.depth)) continue;
+    const double relative_error = (view.evaluation.scale * point.depth - truths.back()) / truths.back();
+    squared_relative_error += relative_error * relative_error;
+    ++scored;
+  }
+  constexpr double kLeastAutomaticScale = 0.005;
+  view.full_scale_error = options.full_scale_error > 0 ? options.full_scale_error
+                          : scored > 0 ? std::max(kLeastAutomaticScale, 3 * std::sqrt(squared_relative_error / scored))
+                                       : kLeastAutomaticScale;
   cv::Mat colour_panel = bgr.clone();
   cv::Mat depth_panel = has_depth ? ColourDepth(depth_mm, options.near_mm, options.far_mm) : cv::Mat();
+  auto truth = truths.begin();
   for (const auto& [id, point] : points) {
-    // Without a scale nothing is scored, and a frame with a scale has depth to sample.
-    const double truth = view.evaluation.evaluated ? SampleDepth(depth_mm, point.pixel).value_or(kNoDepth) : kNoDepth;
-    if (std::isnan(truth) || !std::isfinite(point.depth)) {
+    const double true_depth = *truth++;
+    if (std::isnan(true_depth) || !std::isfinite(point.depth)) {
       DrawRing(colour_panel, point.pixel, options.point_radius_px);
       continue;
     }
     const double scaled = view.evaluation.scale * point.depth;
     DrawDisc(colour_panel, point.pixel, options.point_radius_px,
-             ErrorColour((scaled - truth) / truth, options.full_scale_error));
+             ErrorColour((scaled - true_depth) / true_depth, view.full_scale_error));
     DrawDisc(depth_panel, point.pixel, options.point_radius_px, DepthColour(scaled, options.near_mm, options.far_mm));
   }
   if (has_depth) {

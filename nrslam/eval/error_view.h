@@ -13,7 +13,9 @@ namespace nrslam {
 struct ErrorViewOptions {
   double near_mm = 10.0;               // depth drawn red, mm
   double far_mm = 120.0;               // depth drawn blue, mm
-  double full_scale_error = 0.25;      // relative depth error drawn at full colour (0.25 = 25 %)
+  // Relative depth error drawn at full colour (0.25 = 25 %); 0: three times the frame's rms
+  // relative error (at least 0.5 %), for runs whose errors are all a few per cent.
+  double full_scale_error = 0.25;
   int point_radius_px = 3;             // disc radius, pixels of the input image
   void Check() const;
 };
@@ -24,6 +26,7 @@ cv::Mat ColourDepth(const cv::Mat& depth_mm, double near_mm, double far_mm);
 struct ErrorView {
   cv::Mat image;               // CV_8UC3: the colour panel, then the depth panel if there is depth
   FrameEvaluation evaluation;  // the frame as the evaluator scores it
+  double full_scale_error = 0; // the relative error drawn at full colour
 };
 
 // Colour panel: `bgr` with each point as a disc coloured by its relative depth error after the
