@@ -1,6 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include "camera_fixtures.h"
+#include "temp_folder.h"
 #include "nrslam/camera/camera.h"
+#include "nrslam/io/camera_file.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/util/error.h"
 
@@ -25,7 +32,8 @@ class CameraModels : public ::testing::TestWithParam<int> {
     switch (GetParam()) {
       case 0: return Pinhole();
       case 1: return SimFisheye();
-      default: return EndomapperLike();
+      case 2: return EndomapperLike();
+      default: return OcamFisheye();
     }
   }
 };
@@ -89,7 +97,7 @@ TEST_P(CameraModels, JsonRoundTrip) {
   EXPECT_EQ(back.params(), cam.params());
 }
 
-INSTANTIATE_TEST_SUITE_P(PinholeAndFisheye, CameraModels, ::testing::Values(0, 1, 2));
+INSTANTIATE_TEST_SUITE_P(PinholeFisheyeAndOcam, CameraModels, ::testing::Values(0, 1, 2, 3));
 
 TEST(Fisheye, SimulatorLensCoversAtLeast160DegreesAndRoundTripsAtItsEdge) {
   const Camera cam = SimFisheye();
@@ -115,6 +123,152 @@ TEST(Fisheye, SimulatorLensCoversAtLeast160DegreesAndRoundTripsAtItsEdge) {
   const Eigen::Vector3d left = cam.Unproject(Eigen::Vector2d(0, cam.cy()));
   const Eigen::Vector3d right = cam.Unproject(Eigen::Vector2d(cam.width() - 1, cam.cy()));
   EXPECT_GE(std::acos(left.dot(right)), 160 * M_PI / 180);
+}
+
+TEST(Ocam, RaysAgreeWithOCamCalibsDirectPolynomial) {
+  const Camera cam = OcamFisheye();
+  cam.Check();
+  // Rays of OCamCalib's cam2world (direct polynomial, its axes swapped into ours), worked out
+  // apart from this code; the model inverts the inverse polynomial, which agrees to ~0.002 px.
+  const struct {
+    double u, v;
+    Eigen::Vector3d ray;
+  } known[] = {{400, 0, {-0.059568, -0.981722, 0.180757}},
+               {0, 0, {-0.594919, -0.549548, -0.586573}},
+               {700, 600, {0.745340, 0.564661, 0.354439}},
+               {523.714757, 390.949324, {0.340009, 0.000111, 0.940422}}};
+  for (const auto& [u, v, ray] : known) {
+    EXPECT_LT((cam.Unproject(Eigen::Vector2d(u, v)) - ray).norm(), 2e-5) << u << ", " << v;
+  }
+  EXPECT_NEAR(cam.max_theta() * 180 / M_PI, 128.456, 0.01);  // the bottom-left corner
+  EXPECT_NEAR(cam.fx(), 289.37, 0.01);                      // invpol' on the axis, px per radian
+  EXPECT_TRUE(cam.Project(Eigen::Vector3d(1, 0, -0.5)).has_value()) << "a ray 117° off the axis is in view";
+  EXPECT_FALSE(cam.Project(Eigen::Vector3d(0.1, 0, -1)).has_value()) << "174° off the axis is not";
+}
+
+// A Kannala–Brandt camera written in OCamCalib's terms: f·r(θ) expanded about θ = π/2 is an
+// exact inverse polynomial, the direct one is fitted, fy / fx is the affine c.
+Camera OcamFromKannalaBrandt(const Camera& kb) {
+  const std::vector<double>& p = kb.params();
+  const double radius[10] = {0, p[0], 0, p[0] * p[4], 0, p[0] * p[5], 0, p[0] * p[6], 0, p[0] * p[7]};
+  std::vector<double> inverse(10, 0.0);
+  for (int n = 1; n < 10; ++n) {
+    double binomial = 1;  // C(n, j)
+    for (int j = 0; j <= n; ++j) {
+      inverse[j] += radius[n] * binomial * std::pow(M_PI / 2, n - j);
+      binomial = binomial * (n - j) / (j + 1);
+    }
+  }
+  constexpr int kSamples = 400, kDegree = 7;
+  const double widest = std::hypot(std::max(kb.cx(), kb.width() - 1 - kb.cx()), std::max(kb.cy(), kb.height() - 1 - kb.cy()));
+  Eigen::MatrixXd basis(kSamples + 1, kDegree + 1);
+  Eigen::VectorXd z(kSamples + 1);
+  for (int i = 0; i <= kSamples; ++i) {
+    const double rho = widest * i / kSamples;
+    const Eigen::Vector3d ray = kb.Unproject(Eigen::Vector2d(kb.cx() + rho, kb.cy()));
+    const double theta = std::atan2(ray.head<2>().norm(), ray.z());
+    z[i] = i == 0 ? -p[0] : -rho / std::tan(theta);
+    for (int k = 0; k <= kDegree; ++k) basis(i, k) = std::pow(rho / widest, k);
+  }
+  const Eigen::VectorXd scaled = basis.colPivHouseholderQr().solve(z);
+  std::vector<double> direct(kDegree + 1);
+  for (int k = 0; k <= kDegree; ++k) direct[k] = scaled[k] / std::pow(widest, k);
+  return Camera::Ocam(kb.width(), kb.height(), kb.cx(), kb.cy(), kb.fy() / kb.fx(), 0, 0, direct, inverse);
+}
+
+TEST(Ocam, AKannalaBrandtCameraInOCamCalibsTermsProjectsAndUnprojectsAlike) {
+  // The simulator's lens, and one with non-square pixels and its centre off the middle (the
+  // Endomapper-like calibration folds back before its corners, so no OCam model covers its image).
+  const Camera oblong = Camera::KannalaBrandt(640, 480, 223.0, 227.5, 331.2, 228.7, Eigen::Vector4d(-0.02, 0.002, 0, 0));
+  for (const Camera& kb : {SimFisheye(), oblong}) {
+    const Camera ocam = OcamFromKannalaBrandt(kb);
+    ocam.Check();
+    int checked = 0;
+    for (int y = 0; y < kb.height(); y += 7) {
+      for (int x = 0; x < kb.width(); x += 7) {
+        const Eigen::Vector2d pixel(x + 0.3, y + 0.6);
+        const Eigen::Vector3d ray = kb.Unproject(pixel);
+        if (std::acos(ray.z()) > std::min(kb.max_theta(), ocam.max_theta()) - 1e-6) continue;
+        ASSERT_LT((ocam.Unproject(pixel) - ray).norm(), 1e-9) << pixel.transpose();
+        const auto projected = ocam.Project(3.0 * ray);
+        ASSERT_TRUE(projected.has_value());
+        ASSERT_LT((*projected - pixel).norm(), 1e-8) << pixel.transpose();
+        ASSERT_LT((ocam.ProjectionJacobian(ray) - kb.ProjectionJacobian(ray)).norm(), 1e-7) << pixel.transpose();
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, kb.width() * kb.height() / 49 / 2);
+  }
+}
+
+TEST(Ocam, WrongCalibrationsAreNamed) {
+  auto message = [](const std::function<Camera()>& make) {
+    try {
+      make().Check();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(OcamFisheye), "");
+  EXPECT_NE(message([] {
+              return Camera::Ocam(848, 800, 390.949324, 423.714757, 0.999134, -0.000325, -0.000071, kOcamDirect,
+                                  kOcamInverse);
+            }).find("disagree"),
+            std::string::npos)
+      << "centre's row and column swapped";
+  std::vector<double> positive = kOcamDirect;
+  positive[0] = 289.5569;
+  EXPECT_NE(message([&] { return Camera::Ocam(848, 800, 423.7, 390.9, 1, 0, 0, positive, kOcamInverse); })
+                .find("must be negative"),
+            std::string::npos);
+  EXPECT_NE(message([] { return Camera::Ocam(848, 800, 423.7, 390.9, 1, 0, 0, {}, kOcamInverse); }).find("coefficients"),
+            std::string::npos);
+  nlohmann::json json = OcamFisheye();
+  json.erase("invpol");
+  EXPECT_NE(message([&] { return json.get<Camera>(); }).find("missing field 'invpol'"), std::string::npos);
+}
+
+TEST(Ocam, CalibResultsTxtIsReadAsOCamCalibWritesIt) {
+  const auto folder = UniqueTempFolder("ocam_file");
+  std::filesystem::create_directories(folder);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(folder / name) << text;
+    return folder / name;
+  };
+  const std::string header =
+      "#polynomial coefficients for the DIRECT mapping function (ocam_model.ss in MATLAB). These are used by "
+      "cam2world\n\n5 -2.895569e+02 0.000000e+00 1.538894e-03 -3.140320e-06 7.206996e-09 \n\n"
+      "#polynomial coefficients for the inverse mapping function (ocam_model.invpol in MATLAB). These are used by "
+      "world2cam\n\n13 434.372025 226.016722 -31.205890 43.418508 11.945692 -5.582063 36.541804 -10.674868 "
+      "-55.334360 1.105775 43.550131 25.374995 4.505945 \n\n"
+      "#center: \"row\" and \"column\", starting from 0 (C convention)\n\n390.949324 423.714757\n\n";
+  const std::string tail = "#affine parameters \"c\", \"d\", \"e\"\n\n0.999134 -0.000325 -0.000071\n\n"
+                           "#image size: \"height\" and \"width\"\n\n800 848\n";
+  const Camera camera = ReadCameraFile(write("calib_results.txt", header + tail));
+  EXPECT_EQ(camera.model(), CameraModelId::kOcam);
+  EXPECT_EQ(camera.width(), 848);
+  EXPECT_EQ(camera.height(), 800);
+  EXPECT_EQ(camera.params(), OcamFisheye().params());
+
+  const auto message = [&](const std::string& text) {
+    try {
+      ReadCameraFile(write("broken.txt", text));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message(header).find("expected 5 lines of numbers"), std::string::npos);
+  std::string miscounted = header + tail;
+  miscounted.replace(miscounted.find("\n13 "), 4, "\n12 ");
+  EXPECT_NE(message(miscounted).find("inverse polynomial (invpol): the first number must count"), std::string::npos);
+  EXPECT_NE(message(header + tail.substr(0, tail.find("800"))  + "800 x\n").find("image size"), std::string::npos);
+  EXPECT_EQ(message(header + tail), "");
+  EXPECT_NE(message(header + tail.substr(0, tail.find("800"))).find((folder / "broken.txt").string()),
+            std::string::npos)
+      << "the file is named";
+  std::filesystem::remove_all(folder);
 }
 
 TEST(CameraCheck, RejectsWrongCalibrations) {

@@ -5,6 +5,7 @@
 
 #include <memory>
 
+#include "camera_fixtures.h"
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
 #include "nrslam/geometry/two_view.h"
@@ -38,7 +39,7 @@ void ExpectGradientsMatch(const ceres::CostFunction& cost, const std::vector<con
 std::vector<Camera> Cameras() {
   SimCameraOptions fisheye;
   fisheye.model = "fisheye";
-  return {Camera::Pinhole(640, 480, 320, 318, 319.5, 239.5), MakeSimCamera(fisheye)};
+  return {Camera::Pinhole(640, 480, 320, 318, 319.5, 239.5), MakeSimCamera(fisheye), OcamFisheye()};
 }
 
 TEST(ReprojectionCost, GradientsAtRandomPointsForEveryCameraModel) {

@@ -2,7 +2,9 @@
 
 #include <ceres/jet.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 #include "nrslam/util/error.h"
@@ -30,11 +32,52 @@ Camera Camera::KannalaBrandt(int width, int height, double fx, double fy, double
   return camera;
 }
 
+Camera Camera::Ocam(int width, int height, double cx, double cy, double c, double d, double e,
+                    const std::vector<double>& direct, const std::vector<double>& inverse) {
+  Camera camera;
+  camera.model_ = CameraModelId::kOcam;
+  camera.width_ = width;
+  camera.height_ = height;
+  if (direct.empty() || direct.size() > OcamModel::kMaxDirect || inverse.size() < 2 ||
+      inverse.size() > OcamModel::kMaxInverse) {
+    std::ostringstream text;
+    text << "camera: ocam needs 1 to " << OcamModel::kMaxDirect << " direct (ss) and 2 to " << OcamModel::kMaxInverse
+         << " inverse (invpol) coefficients, got " << direct.size() << " and " << inverse.size();
+    throw Error(text.str());
+  }
+  camera.params_.assign(OcamModel::kNumParams, 0.0);
+  std::copy(direct.begin(), direct.end(), camera.params_.begin() + OcamModel::kDirectOffset);
+  std::copy(inverse.begin(), inverse.end(), camera.params_.begin() + OcamModel::kInverseOffset);
+  const double focal = OcamModel::InverseDerivative(camera.params_.data(), -M_PI / 2);
+  const double derived[] = {focal, focal * c, cx, cy, c, d, e};
+  std::copy(std::begin(derived), std::end(derived), camera.params_.begin());
+  camera.ComputeMaxTheta();
+  return camera;
+}
+
 std::string Camera::model_name() const {
   return VisitCameraModel(model_, [](auto model) { return std::string(decltype(model)::kName); });
 }
 
 void Camera::ComputeMaxTheta() {
+  if (model_ == CameraModelId::kOcam) {
+    // Beyond the image the polynomials extrapolate; the border's widest ray bounds what is seen.
+    max_theta_ = 0.0;
+    const auto widen = [&](double u, double v) {
+      const Eigen::Vector3d ray = OcamModel::Unproject(params_.data(), u, v);
+      max_theta_ = std::max(max_theta_, std::atan2(ray.head<2>().norm(), ray.z()));
+    };
+    for (int x = 0; x < width_; ++x) {
+      widen(x, 0);
+      widen(x, height_ - 1);
+    }
+    for (int y = 0; y < height_; ++y) {
+      widen(0, y);
+      widen(width_ - 1, y);
+    }
+    if (!std::isfinite(max_theta_)) max_theta_ = 0.0;
+    return;
+  }
   if (model_ == CameraModelId::kPinhole || params_.size() != KannalaBrandtModel::kNumParams) {
     max_theta_ = M_PI / 2;
     return;
@@ -65,7 +108,8 @@ std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& point) con
 Eigen::Vector3d Camera::Unproject(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector3d bearing = VisitCameraModel(
       model_, [&](auto model) { return decltype(model)::Unproject(params_.data(), pixel.x(), pixel.y()); });
-  if (model_ == CameraModelId::kPinhole) return bearing;
+  // Pinhole rays cover the plane; OCam's max_theta() is the image border's widest ray.
+  if (model_ != CameraModelId::kKannalaBrandt) return bearing;
   // Pixels beyond the image circle (past the largest r(θ) the lens reaches) have no ray;
   // give them the ray at the edge of the field of view in their direction.
   const double mx = (pixel.x() - cx()) / fx(), my = (pixel.y() - cy()) / fy();
@@ -95,7 +139,7 @@ void Camera::Check() const {
     text << "image size must be positive, got " << width_ << "x" << height_;
     fail(text.str());
   }
-  const size_t expected = model_ == CameraModelId::kPinhole ? 4 : 8;
+  const size_t expected = VisitCameraModel(model_, [](auto model) { return size_t{decltype(model)::kNumParams}; });
   if (params_.size() != expected) {
     text << model_name() << " needs " << expected << " parameters, got " << params_.size();
     fail(text.str());
@@ -118,28 +162,98 @@ void Camera::Check() const {
          << " rad; the calibration is wrong";
     fail(text.str());
   }
+  if (model_ == CameraModelId::kOcam) CheckOcam();
 }
 
-void to_json(nlohmann::json& j, const Camera& camera) {
-  j = nlohmann::json{{"model", camera.model_name()}, {"width", camera.width()}, {"height", camera.height()},
-                     {"fx", camera.fx()}, {"fy", camera.fy()}, {"cx", camera.cx()}, {"cy", camera.cy()}};
-  if (camera.model() == CameraModelId::kKannalaBrandt) {
-    const auto& p = camera.params();
-    j["k"] = {p[4], p[5], p[6], p[7]};
+void Camera::CheckOcam() const {
+  auto fail = [](const std::string& what) { throw Error("camera: ocam: " + what); };
+  std::ostringstream text;
+  const double* p = params_.data();
+  if (p[OcamModel::kDirectOffset] >= 0) {
+    fail("the direct polynomial's constant term (ss[0]) must be negative: OCamCalib's z points out of the lens");
   }
+  if (std::abs(p[4] - p[5] * p[6]) < 0.5) fail("the affine part [c d; e 1] is (nearly) singular");
+  const double on_axis = OcamModel::Inverse(p, -M_PI / 2);
+  if (std::abs(on_axis) > 0.5) {
+    text << "the inverse polynomial puts the optical axis " << on_axis << " px from the centre (at most 0.5)";
+    fail(text.str());
+  }
+  // The radius must grow with the angle up to the widest ray of the image, or pixels would share a ray.
+  constexpr double kStep = 1e-3;
+  for (double phi = kStep; phi <= max_theta_; phi += kStep) {
+    if (OcamModel::Radius(p, phi) <= OcamModel::Radius(p, phi - kStep)) {
+      text << "the inverse polynomial folds back at " << phi << " rad, inside the image";
+      fail(text.str());
+    }
+  }
+  // Both polynomials come from one calibration: the direct polynomial's ray of a pixel, projected
+  // with the inverse one, must land on that pixel.
+  constexpr int kGrid = 8;
+  constexpr double kMaxDisagreementPx = 0.5;
+  for (int y = 0; y < height_; y += kGrid) {
+    for (int x = 0; x < width_; x += kGrid) {
+      Eigen::Vector2d pixel;
+      const Eigen::Vector3d ray = OcamModel::DirectRay(p, x, y);
+      if (!OcamModel::Project(p, ray.data(), pixel.data()) || (pixel - Eigen::Vector2d(x, y)).norm() > kMaxDisagreementPx) {
+        text << "the direct (ss) and inverse (invpol) polynomials disagree at pixel (" << x << ", " << y
+             << "): not one calibration, or the centre's row and column swapped";
+        fail(text.str());
+      }
+    }
+  }
+}
+
+namespace {
+
+// A polynomial's coefficients from params, without the unused trailing zeros.
+std::vector<double> Coefficients(const std::vector<double>& params, int offset, int count) {
+  auto end = params.begin() + offset + count;
+  while (end > params.begin() + offset + 1 && *(end - 1) == 0.0) --end;
+  return std::vector<double>(params.begin() + offset, end);
+}
+
+}  // namespace
+
+void to_json(nlohmann::json& j, const Camera& camera) {
+  const auto& p = camera.params();
+  j = nlohmann::json{{"model", camera.model_name()}, {"width", camera.width()}, {"height", camera.height()},
+                     {"cx", camera.cx()}, {"cy", camera.cy()}};
+  if (camera.model() == CameraModelId::kOcam) {
+    j["c"] = p[4];
+    j["d"] = p[5];
+    j["e"] = p[6];
+    j["ss"] = Coefficients(p, OcamModel::kDirectOffset, OcamModel::kMaxDirect);
+    j["invpol"] = Coefficients(p, OcamModel::kInverseOffset, OcamModel::kMaxInverse);
+    return;
+  }
+  j["fx"] = camera.fx();
+  j["fy"] = camera.fy();
+  if (camera.model() == CameraModelId::kKannalaBrandt) j["k"] = {p[4], p[5], p[6], p[7]};
 }
 
 void from_json(const nlohmann::json& j, Camera& camera) {
   if (!j.is_object()) throw Error("camera: expected a JSON object");
-  for (const char* key : {"model", "width", "height", "fx", "fy", "cx", "cy"}) {
-    if (!j.contains(key)) throw Error(std::string("camera: missing field '") + key + "'");
-  }
+  const auto require = [&](std::initializer_list<const char*> keys) {
+    for (const char* key : keys) {
+      if (!j.contains(key)) throw Error(std::string("camera: missing field '") + key + "'");
+    }
+  };
+  require({"model", "width", "height", "cx", "cy"});
   try {
     const std::string model = j.at("model").get<std::string>();
     const int width = j.at("width").get<int>();
     const int height = j.at("height").get<int>();
-    const double fx = j.at("fx").get<double>(), fy = j.at("fy").get<double>();
     const double cx = j.at("cx").get<double>(), cy = j.at("cy").get<double>();
+    if (model == OcamModel::kName) {
+      require({"ss", "invpol"});
+      // No affine part given: the identity, as OCamCalib starts from.
+      camera = Camera::Ocam(width, height, cx, cy, j.value("c", 1.0), j.value("d", 0.0), j.value("e", 0.0),
+                            j.at("ss").get<std::vector<double>>(), j.at("invpol").get<std::vector<double>>());
+      camera.Check();
+      return;
+    }
+    require({"fx", "fy"});
+    const double fx = j.at("fx").get<double>(), fy = j.at("fy").get<double>();
     if (model == PinholeModel::kName) {
       camera = Camera::Pinhole(width, height, fx, fy, cx, cy);
     } else if (model == KannalaBrandtModel::kName) {
@@ -149,7 +263,7 @@ void from_json(const nlohmann::json& j, Camera& camera) {
       const auto k = j.at("k").get<std::vector<double>>();
       camera = Camera::KannalaBrandt(width, height, fx, fy, cx, cy, Eigen::Vector4d(k[0], k[1], k[2], k[3]));
     } else {
-      throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt)");
+      throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt, ocam)");
     }
   } catch (const nlohmann::json::exception& e) {
     throw Error(std::string("camera: malformed field: ") + e.what());

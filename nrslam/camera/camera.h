@@ -18,6 +18,10 @@ class Camera {
   static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
   static Camera KannalaBrandt(int width, int height, double fx, double fy, double cx, double cy,
                               const Eigen::Vector4d& k);
+  // OCamCalib's model (camera_models.h): centre at column cx, row cy; `direct` is ss and
+  // `inverse` is invpol, lowest order first, at most OcamModel::kMaxDirect / kMaxInverse terms.
+  static Camera Ocam(int width, int height, double cx, double cy, double c, double d, double e,
+                     const std::vector<double>& direct, const std::vector<double>& inverse);
 
   CameraModelId model() const { return model_; }
   std::string model_name() const;
@@ -30,7 +34,8 @@ class Camera {
   double cy() const { return params_[3]; }
 
   // Largest angle from the optical axis the model maps one-to-one (rad): π/2 for pinhole,
-  // the end of the monotonic part of r(θ) for Kannala–Brandt (at most π).
+  // the end of the monotonic part of r(θ) for Kannala–Brandt (at most π), the widest ray of
+  // the image's border for OCam (its polynomials are fitted over the image only).
   double max_theta() const { return max_theta_; }
 
   // Pixel of a point in camera coordinates; nullopt when the point is behind the camera
@@ -58,6 +63,7 @@ class Camera {
   std::vector<double> params_;
   double max_theta_ = 0.0;
   void ComputeMaxTheta();
+  void CheckOcam() const;
 };
 
 void to_json(nlohmann::json& j, const Camera& camera);

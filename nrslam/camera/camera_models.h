@@ -11,7 +11,7 @@
 
 namespace nrslam {
 
-enum class CameraModelId { kPinhole, kKannalaBrandt };
+enum class CameraModelId { kPinhole, kKannalaBrandt, kOcam };
 
 // params = [fx, fy, cx, cy]
 struct PinholeModel {
@@ -89,12 +89,114 @@ struct KannalaBrandtModel {
   }
 };
 
+// Scaramuzza's omnidirectional model as OCamCalib calibrates it (the model of C3VD and of many
+// endoscope calibrations). OCamCalib's own frame has x down the rows, y along the columns and z
+// out of the lens; here the usual frame is kept and the axes swapped inside.
+// params = [f, f·c, cx, cy, c, d, e, ss[kMaxDirect], invpol[kMaxInverse]]:
+//  - (cx, cy): the centre's column and row (OCamCalib writes "row column");
+//  - c, d, e: the affine part, [row; col] offsets = [c d; e 1] · (a, b), where (a, b) are the
+//    offsets along OCamCalib's x and y before it;
+//  - ss: the direct polynomial: a pixel at distance ρ from the centre (after the affine part)
+//    looks along (a, b, ss(ρ)) in OCamCalib's frame; unused trailing terms are 0;
+//  - invpol: the inverse polynomial ρ(t), t = φ − π/2, φ the angle from the optical axis. Its
+//    value on the axis (calibrations leave it at ~1e-3 px) is subtracted, so the axis maps to
+//    the centre exactly;
+//  - f, f·c: ρ'(0) in pixels per radian along the columns and the rows, derived; what the
+//    other models call fx, fy, used for pixel-angle scales.
+// Projection uses invpol (what the residuals differentiate); Unproject inverts exactly that
+// projection by Newton's method, starting from the direct polynomial's ray.
+struct OcamModel {
+  static constexpr CameraModelId kId = CameraModelId::kOcam;
+  static constexpr int kMaxDirect = 8;
+  static constexpr int kMaxInverse = 32;
+  static constexpr int kDirectOffset = 7;
+  static constexpr int kInverseOffset = kDirectOffset + kMaxDirect;
+  static constexpr int kNumParams = kInverseOffset + kMaxInverse;
+  static constexpr const char* kName = "ocam";
+
+  // invpol(t) and its derivative, by Horner.
+  template <typename T>
+  static T Inverse(const T* params, const T& t) {
+    T value(0);
+    for (int i = kMaxInverse - 1; i >= 0; --i) value = value * t + params[kInverseOffset + i];
+    return value;
+  }
+  template <typename T>
+  static T InverseDerivative(const T* params, const T& t) {
+    T value(0);
+    for (int i = kMaxInverse - 1; i >= 1; --i) value = value * t + T(double(i)) * params[kInverseOffset + i];
+    return value;
+  }
+  // Pixel distance from the centre (before the affine part) of a ray φ off the axis.
+  template <typename T>
+  static T Radius(const T* params, const T& phi) {
+    const T axis(-M_PI / 2);
+    return Inverse(params, phi + axis) - Inverse(params, axis);
+  }
+
+  template <typename T>
+  static bool Project(const T* params, const T* point, T* pixel) {
+    using std::atan2;
+    using std::sqrt;
+    const T& along_rows = point[1];
+    const T& along_columns = point[0];
+    const T norm2 = along_rows * along_rows + along_columns * along_columns;
+    T scale;  // ρ / ‖(x, y)‖
+    if (norm2 < T(1e-20) * point[2] * point[2]) {
+      if (!(point[2] > T(0))) return false;
+      scale = InverseDerivative(params, T(-M_PI / 2)) / point[2];
+    } else {
+      const T norm = sqrt(norm2);
+      scale = Radius(params, atan2(norm, point[2])) / norm;
+    }
+    const T a = scale * along_rows, b = scale * along_columns;
+    pixel[1] = params[4] * a + params[5] * b + params[3];
+    pixel[0] = params[6] * a + b + params[2];
+    return true;
+  }
+
+  // Offsets (a along the rows, b along the columns) of a pixel before the affine part.
+  static Eigen::Vector2d Unaffine(const double* params, double u, double v) {
+    const double row = v - params[3], column = u - params[2];
+    const double c = params[4], d = params[5], e = params[6];
+    const double det = c - d * e;
+    return Eigen::Vector2d((row - d * column) / det, (c * column - e * row) / det);
+  }
+
+  // The ray OCamCalib's direct polynomial gives a pixel (unit bearing, usual frame).
+  static Eigen::Vector3d DirectRay(const double* params, double u, double v) {
+    const Eigen::Vector2d ab = Unaffine(params, u, v);
+    const double rho = ab.norm();
+    double z = 0.0;
+    for (int i = kMaxDirect - 1; i >= 0; --i) z = z * rho + params[kDirectOffset + i];
+    return Eigen::Vector3d(ab.y(), ab.x(), -z).normalized();
+  }
+
+  static Eigen::Vector3d Unproject(const double* params, double u, double v) {
+    const Eigen::Vector2d ab = Unaffine(params, u, v);
+    const double rho = ab.norm();
+    if (rho < 1e-12) return Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d start = DirectRay(params, u, v);
+    double phi = std::atan2(start.head<2>().norm(), start.z());
+    for (int iteration = 0; iteration < 30; ++iteration) {
+      const double step =
+          (Radius(params, phi) - rho) / InverseDerivative(params, phi - M_PI / 2);
+      phi -= step;
+      if (std::abs(step) < 1e-13) break;
+    }
+    const double s = std::sin(phi) / rho;
+    return Eigen::Vector3d(s * ab.y(), s * ab.x(), std::cos(phi));
+  }
+};
+
 // Calls f(Model{}) with the model type for `id`, so templated code is written once.
 template <typename Function>
 decltype(auto) VisitCameraModel(CameraModelId id, Function&& f) {
   switch (id) {
     case CameraModelId::kKannalaBrandt:
       return f(KannalaBrandtModel{});
+    case CameraModelId::kOcam:
+      return f(OcamModel{});
     case CameraModelId::kPinhole:
     default:
       return f(PinholeModel{});
