@@ -894,6 +894,24 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   EXPECT_GT(same.mean_common_points, 8.0);
   EXPECT_LE(same.mean_common_points, std::min(same.mean_points_a, same.mean_points_b));
 
+  // nrslam_preview draws a frame of both runs, one view under the other, each colour | depth
+  // under a caption; a folder that is no run is refused.
+  {
+    const std::string preview = NRSLAM_TOOLS_DIR "/nrslam_preview";
+    const std::filesystem::path picture = folder / "views.png";
+    const std::string both = preview + " --run " + results[0].run_folder + " --run " + results[2].run_folder +
+                             " --frame 3 --out " + picture.string() + " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(both.c_str()), 0) << both;
+    const cv::Mat views = cv::imread(picture.string());
+    const cv::Mat frame = cv::imread((plan.runs[0].sequence_folder / "rgb" / "000003.png").string());
+    ASSERT_FALSE(frame.empty());
+    EXPECT_EQ(views.cols, 2 * frame.cols);
+    EXPECT_GT(views.rows, 2 * frame.rows);
+    const std::string with_broken = preview + " --run " + results[0].run_folder + " --run " +
+                                    (folder / "broken").string() + " --out " + picture.string() + " > /dev/null 2>&1";
+    EXPECT_NE(std::system(with_broken.c_str()), 0);
+  }
+
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,
   // and the failed sequence is shown as such.
   WriteReport(results, comparisons, GroupBySeed(plan, results), folder / "out" / "report");

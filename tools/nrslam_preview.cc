@@ -1,7 +1,7 @@
 // nrslam_preview: writes one frame of a sequence as a PNG: the colour image beside its
 // ground-truth depth in false colour (near = red, far = blue, black = none). With --run, the
 // run's points on that frame are drawn over both panels, coloured by their depth error, with
-// the frame's state and RMSE above.
+// the frame's state and RMSE above; with several, one such view per run, one under the other.
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -69,47 +69,77 @@ cv::Mat WithCaption(const cv::Mat& image, const std::vector<std::string>& lines)
   return out;
 }
 
-// A sequence, and optionally a run of it read once, drawn frame by frame.
+// One run folder, read once.
+struct RunRecord {
+  explicit RunRecord(const fs::path& folder)
+      : name(folder.lexically_normal().filename().string()),
+        sequence(nrslam::ReadJsonFile(folder / "config.json").at("sequence").get<std::string>()),
+        points(nrslam::ReadRunPoints(folder)),
+        states(RecordedStates(folder)),
+        evaluation(nrslam::RunEvaluationOptions(folder)) {}
+  std::string name;
+  std::string sequence;  // the sequence it ran on
+  nrslam::RunPoints points;
+  std::map<int, std::string> states;
+  nrslam::EvaluationOptions evaluation;
+};
+
+// A sequence, and any runs of it, drawn frame by frame: one view per run, one under the other.
 class Preview {
  public:
-  Preview(const std::string& sequence, const std::string& run, const nrslam::ErrorViewOptions& options, double scale)
-      : reader_(sequence), run_(run), options_(options), scale_(scale) {
-    if (run_.empty()) return;
-    run_points_ = nrslam::ReadRunPoints(run_);
-    states_ = RecordedStates(run_);
-    evaluation_ = nrslam::RunEvaluationOptions(run_);
-  }
+  Preview(const std::string& sequence, const std::vector<std::string>& runs, const nrslam::ErrorViewOptions& options,
+          double scale)
+      : runs_(runs.begin(), runs.end()), reader_(sequence.empty() ? SequenceOfRuns() : sequence), options_(options),
+        scale_(scale) {}
 
   int frame_count() const { return reader_.frame_count(); }
 
   cv::Mat Draw(int frame) const {
     const cv::Mat colour = reader_.ReadRgb(frame);
     const cv::Mat depth = reader_.has_depth() ? reader_.ReadDepthMm(frame) : cv::Mat();
-    std::vector<std::string> caption;
-    cv::Mat panel = colour;
-    if (!run_.empty()) {
-      const auto found = run_points_.find(frame);
-      const nrslam::FramePoints points = found == run_points_.end() ? nrslam::FramePoints() : found->second;
-      const nrslam::ErrorView view = nrslam::DrawErrorView(colour, depth, points, evaluation_, options_);
-      panel = view.image;
-      const auto state = states_.find(frame);
-      caption = Caption(run_.lexically_normal().filename().string(), frame, state == states_.end() ? "" : state->second,
-                        points, view);
-    } else if (!depth.empty()) {
-      cv::hconcat(colour, nrslam::ColourDepth(depth, options_.near_mm, options_.far_mm), panel);
+    if (runs_.empty()) {
+      cv::Mat panel = colour;
+      if (!depth.empty()) cv::hconcat(colour, nrslam::ColourDepth(depth, options_.near_mm, options_.far_mm), panel);
+      return Scaled(panel);
     }
-    if (scale_ != 1.0) cv::resize(panel, panel, cv::Size(), scale_, scale_, scale_ < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
-    return caption.empty() ? panel : WithCaption(panel, caption);
+    std::vector<cv::Mat> views;
+    for (const RunRecord& run : runs_) {
+      const auto found = run.points.find(frame);
+      const nrslam::FramePoints points = found == run.points.end() ? nrslam::FramePoints() : found->second;
+      const nrslam::ErrorView view = nrslam::DrawErrorView(colour, depth, points, run.evaluation, options_);
+      const auto state = run.states.find(frame);
+      views.push_back(WithCaption(Scaled(view.image), Caption(run.name, frame, state == run.states.end() ? "" : state->second,
+                                                              points, view)));
+    }
+    cv::Mat stacked;
+    cv::vconcat(views, stacked);
+    return stacked;
   }
 
  private:
+  // The runs' own sequence: they must all have run on the same one.
+  std::string SequenceOfRuns() const {
+    if (runs_.empty()) throw nrslam::Error("give a sequence folder, or --run with a run folder");
+    for (const RunRecord& run : runs_) {
+      if (run.sequence != runs_.front().sequence) {
+        throw nrslam::Error("the runs are of different sequences: " + runs_.front().sequence + " (" +
+                            runs_.front().name + ") and " + run.sequence + " (" + run.name + ")");
+      }
+    }
+    return runs_.front().sequence;
+  }
+
+  cv::Mat Scaled(const cv::Mat& image) const {
+    if (scale_ == 1.0) return image;
+    cv::Mat resized;
+    cv::resize(image, resized, cv::Size(), scale_, scale_, scale_ < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    return resized;
+  }
+
+  std::vector<RunRecord> runs_;
   nrslam::SequenceReader reader_;
-  fs::path run_;
   nrslam::ErrorViewOptions options_;
   double scale_;
-  nrslam::RunPoints run_points_;
-  std::map<int, std::string> states_;
-  nrslam::EvaluationOptions evaluation_;
 };
 
 void WritePng(const fs::path& file, const cv::Mat& image) {
@@ -119,16 +149,19 @@ void WritePng(const fs::path& file, const cv::Mat& image) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Write a frame of a sequence (colour | depth) as a PNG; with --run, the run's points coloured by their "
-               "depth error"};
+  CLI::App app{"Write a frame of a sequence (colour | depth) as a PNG; with --run, each run's points coloured by "
+               "their depth error"};
   app.set_version_flag("--version", nrslam::VersionString());
-  std::string sequence, run, out;
+  std::string sequence, out;
+  std::vector<std::string> runs;
   int frame = 0;
   bool all_frames = false;
   nrslam::ErrorViewOptions view_options;
   double scale = 1.0;
   app.add_option("sequence", sequence, "sequence folder (with --run: the run's own, from its config.json, if not given)");
-  app.add_option("--run", run, "a run folder of nrslam_run or nrslam_eval: draw its points of the frame");
+  app.add_option("--run", runs,
+                 "run folders of nrslam_run or nrslam_eval: draw their points of the frame, one view under the other "
+                 "(e.g. deformable and rigid)");
   app.add_option("--frame", frame, "frame index")->capture_default_str();
   app.add_flag("--all", all_frames, "every frame, as OUT/NNNNNN.png (--out is then a folder)");
   app.add_option("--out", out, "output PNG (with --all: a folder)")->required();
@@ -143,11 +176,7 @@ int main(int argc, char** argv) {
   try {
     view_options.Check();
     if (!(scale > 0)) throw nrslam::Error("--scale must be > 0");
-    if (sequence.empty()) {
-      if (run.empty()) throw nrslam::Error("give a sequence folder, or --run with a run folder");
-      sequence = nrslam::ReadJsonFile(fs::path(run) / "config.json").at("sequence").get<std::string>();
-    }
-    const Preview preview(sequence, run, view_options, scale);
+    const Preview preview(sequence, runs, view_options, scale);
     if (!all_frames) {
       WritePng(out, preview.Draw(frame));
       return 0;
