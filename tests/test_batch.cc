@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -910,6 +911,16 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
     const std::string with_broken = preview + " --run " + results[0].run_folder + " --run " +
                                     (folder / "broken").string() + " --out " + picture.string() + " > /dev/null 2>&1";
     EXPECT_NE(std::system(with_broken.c_str()), 0);
+    // Every frame as a video: as many frames as the sequence has, each the size of the view.
+    const std::filesystem::path video = folder / "views.avi";
+    const std::string all = preview + " --run " + results[0].run_folder + " --run " + results[2].run_folder +
+                            " --all --out " + video.string() + " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(all.c_str()), 0) << all;
+    cv::VideoCapture capture(video.string());
+    ASSERT_TRUE(capture.isOpened());
+    int frames = 0;
+    for (cv::Mat image; capture.read(image); ++frames) EXPECT_EQ(image.size(), views.size());
+    EXPECT_EQ(frames, 8);
   }
 
   // The report opens in a real (headless) browser: every image loads, the plots are drawn,

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -93,6 +94,7 @@ class Preview {
         scale_(scale) {}
 
   int frame_count() const { return reader_.frame_count(); }
+  double fps() const { return reader_.info().fps; }
 
   cv::Mat Draw(int frame) const {
     const cv::Mat colour = reader_.ReadRgb(frame);
@@ -163,8 +165,9 @@ int main(int argc, char** argv) {
                  "run folders of nrslam_run or nrslam_eval: draw their points of the frame, one view under the other "
                  "(e.g. deformable and rigid)");
   app.add_option("--frame", frame, "frame index")->capture_default_str();
-  app.add_flag("--all", all_frames, "every frame, as OUT/NNNNNN.png (--out is then a folder)");
-  app.add_option("--out", out, "output PNG (with --all: a folder)")->required();
+  app.add_flag("--all", all_frames,
+               "every frame: --out is then a folder of NNNNNN.png, or a Motion-JPEG video if it ends in .avi");
+  app.add_option("--out", out, "output PNG (with --all: a folder, or a .avi video)")->required();
   app.add_option("--scale", scale, "resize factor")->capture_default_str();
   app.add_option("--near", view_options.near_mm, "depth shown red, mm")->capture_default_str();
   app.add_option("--far", view_options.far_mm, "depth shown blue, mm")->capture_default_str();
@@ -181,11 +184,24 @@ int main(int argc, char** argv) {
       WritePng(out, preview.Draw(frame));
       return 0;
     }
-    fs::create_directories(out);
-    for (int index = 0; index < preview.frame_count(); ++index) {
-      char name[16];
-      std::snprintf(name, sizeof(name), "%06d.png", index);
-      WritePng(fs::path(out) / name, preview.Draw(index));
+    if (fs::path(out).extension() == ".avi") {
+      // Motion JPEG: OpenCV writes it without any external codec.
+      cv::VideoWriter video;
+      for (int index = 0; index < preview.frame_count(); ++index) {
+        const cv::Mat image = preview.Draw(index);
+        if (!video.isOpened() &&
+            !video.open(out, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), preview.fps(), image.size())) {
+          throw nrslam::Error("cannot write the video " + out);
+        }
+        video.write(image);
+      }
+    } else {
+      fs::create_directories(out);
+      for (int index = 0; index < preview.frame_count(); ++index) {
+        char name[16];
+        std::snprintf(name, sizeof(name), "%06d.png", index);
+        WritePng(fs::path(out) / name, preview.Draw(index));
+      }
     }
     std::cout << "wrote " << preview.frame_count() << " frames to " << out << '\n';
   } catch (const std::exception& e) {
