@@ -146,36 +146,6 @@ TEST(Ocam, RaysAgreeWithOCamCalibsDirectPolynomial) {
   EXPECT_FALSE(cam.Project(Eigen::Vector3d(0.1, 0, -1)).has_value()) << "174° off the axis is not";
 }
 
-// A Kannala–Brandt camera written in OCamCalib's terms: f·r(θ) expanded about θ = π/2 is an
-// exact inverse polynomial, the direct one is fitted, fy / fx is the affine c.
-Camera OcamFromKannalaBrandt(const Camera& kb) {
-  const std::vector<double>& p = kb.params();
-  const double radius[10] = {0, p[0], 0, p[0] * p[4], 0, p[0] * p[5], 0, p[0] * p[6], 0, p[0] * p[7]};
-  std::vector<double> inverse(10, 0.0);
-  for (int n = 1; n < 10; ++n) {
-    double binomial = 1;  // C(n, j)
-    for (int j = 0; j <= n; ++j) {
-      inverse[j] += radius[n] * binomial * std::pow(M_PI / 2, n - j);
-      binomial = binomial * (n - j) / (j + 1);
-    }
-  }
-  constexpr int kSamples = 400, kDegree = 7;
-  const double widest = std::hypot(std::max(kb.cx(), kb.width() - 1 - kb.cx()), std::max(kb.cy(), kb.height() - 1 - kb.cy()));
-  Eigen::MatrixXd basis(kSamples + 1, kDegree + 1);
-  Eigen::VectorXd z(kSamples + 1);
-  for (int i = 0; i <= kSamples; ++i) {
-    const double rho = widest * i / kSamples;
-    const Eigen::Vector3d ray = kb.Unproject(Eigen::Vector2d(kb.cx() + rho, kb.cy()));
-    const double theta = std::atan2(ray.head<2>().norm(), ray.z());
-    z[i] = i == 0 ? -p[0] : -rho / std::tan(theta);
-    for (int k = 0; k <= kDegree; ++k) basis(i, k) = std::pow(rho / widest, k);
-  }
-  const Eigen::VectorXd scaled = basis.colPivHouseholderQr().solve(z);
-  std::vector<double> direct(kDegree + 1);
-  for (int k = 0; k <= kDegree; ++k) direct[k] = scaled[k] / std::pow(widest, k);
-  return Camera::Ocam(kb.width(), kb.height(), kb.cx(), kb.cy(), kb.fy() / kb.fx(), 0, 0, direct, inverse);
-}
-
 TEST(Ocam, AKannalaBrandtCameraInOCamCalibsTermsProjectsAndUnprojectsAlike) {
   // The simulator's lens, and one with non-square pixels and its centre off the middle (the
   // Endomapper-like calibration folds back before its corners, so no OCam model covers its image).

@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 
+#include "camera_fixtures.h"
 #include "temp_folder.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/datasets/dataset_import.h"
@@ -25,6 +26,7 @@
 #include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
+#include "nrslam/sim/renderer.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/run_sequence.h"
@@ -575,6 +577,33 @@ TEST(MonocularRun, RigidSceneGivesAnAccurateGrowingMap) {
   // A still scene fits one shape: after the warm-up every DBA window is adjusted rigidly.
   EXPECT_GT(outcome.rigid_dba, 0);
   EXPECT_EQ(outcome.deformable_dba, 0);
+}
+
+// A lens given as OCamCalib's model (the simulator's fisheye rewritten in its terms, which the
+// simulator then renders with) through the whole monocular system: the model's projection, its
+// Jacobian and its unprojection are all on the path.
+TEST(MonocularRun, AnOcamCalibratedLensIsTrackedToTheEnd) {
+  const fs::path folder = UniqueTempFolder("nrslam_monocular_ocam");
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  SimOptions sim = SimPreset("sim-0");
+  sim.frames = 60;
+  sim.camera.model = "fisheye";
+  sim.camera.width = 320;
+  sim.camera.height = 240;
+  std::ofstream(folder / "ocam.json") << nlohmann::json(OcamFromKannalaBrandt(MakeSimCamera(sim.camera))).dump();
+  sim.camera.calibration = (folder / "ocam.json").string();
+  SimulateSequence(sim, "sim-0-ocam", folder / "sequence");
+  ASSERT_EQ(SequenceReader(folder / "sequence").info().camera.model(), CameraModelId::kOcam);
+  SystemOptions options;  // 320x240: the count thresholds scale down, as for the pinhole run above
+  options.initialisation.min_tracks = 50;
+  options.initialisation.min_points = 50;
+  const RunSummary summary = RunSequence(folder / "sequence", options, folder / "run");
+  std::cout << "sim-0 through an OCam lens, 320x240: init at " << summary.init_frame << ", RMSE " << summary.rmse_mm
+            << " mm (a flat map: " << summary.rmse_flat_mm << " mm)\n";
+  ExpectInitialisedAndTrackedToTheEnd(summary);
+  EXPECT_LT(summary.rmse_mm, 0.3 * summary.rmse_flat_mm);
+  fs::remove_all(folder);
 }
 
 TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {

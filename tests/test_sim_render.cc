@@ -8,10 +8,12 @@
 #include <fstream>
 #include <iterator>
 
+#include "camera_fixtures.h"
 #include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/sim/simulate.h"
+#include "nrslam/util/error.h"
 
 namespace nrslam {
 namespace {
@@ -116,6 +118,45 @@ TEST(SimRender, FisheyeWritesItsImageCircleMask) {
   const cv::Mat depth = reader.ReadDepthMm(0);
   EXPECT_EQ(depth.at<float>(0, 0), 0.f);
   EXPECT_GT(depth.at<float>(60, 80), 0.f);
+  fs::remove_all(folder);
+}
+
+// The simulator's fisheye rewritten in OCamCalib's terms and given as a calibration file: the
+// same rays, so the same depths; its image reaches past the simulator's 85° circle, up to the
+// model's widest ray, and rays 90° or more off the axis have no z-depth.
+TEST(SimRender, ACalibrationFileIsTheLensRenderedWith) {
+  const fs::path folder = UniqueTempFolder("nrslam_calibrated");
+  fs::create_directories(folder);
+  SimOptions fisheye = Small("sim-1");
+  fisheye.camera.model = "fisheye";
+  const Camera ocam = OcamFromKannalaBrandt(MakeSimCamera(fisheye.camera));
+  std::ofstream(folder / "ocam.json") << nlohmann::json(ocam).dump();
+  SimOptions calibrated = Small("sim-1");
+  calibrated.camera.calibration = (folder / "ocam.json").string();
+
+  Renderer lens(fisheye), file(calibrated);
+  EXPECT_EQ(file.camera().model(), CameraModelId::kOcam);
+  const RenderedFrame a = lens.Render(5), b = file.Render(5);
+  ASSERT_EQ(a.left.depth_mm.size(), b.left.depth_mm.size());
+  int compared = 0, beyond_circle = 0;
+  for (int y = 0; y < a.left.depth_mm.rows; ++y) {
+    for (int x = 0; x < a.left.depth_mm.cols; ++x) {
+      const float inside = a.left.depth_mm.at<float>(y, x), calibrated_depth = b.left.depth_mm.at<float>(y, x);
+      if (inside > 0) {
+        ASSERT_NEAR(calibrated_depth, inside, 1e-3) << x << ", " << y;
+        ++compared;
+      } else {
+        beyond_circle += calibrated_depth > 0;
+      }
+      EXPECT_GE(calibrated_depth, 0.f);
+    }
+  }
+  EXPECT_GT(compared, 160 * 120 / 2);
+  EXPECT_GT(beyond_circle, 0);
+  EXPECT_GT(ocam.max_theta(), M_PI / 2);  // so some rays have no z-depth, and none went negative
+
+  calibrated.camera.calibration = (folder / "none.json").string();
+  EXPECT_THROW(Renderer{calibrated}, Error);
   fs::remove_all(folder);
 }
 

@@ -82,7 +82,8 @@ int main(int argc, char** argv) {
       });
       table.AddRow({name, std::to_string(summary.frames),
                     std::to_string(summary.width) + "x" + std::to_string(summary.height),
-                    options.camera.model + (options.camera.stereo ? "+stereo" : ""),
+                    (options.camera.calibration.empty() ? options.camera.model : "calibration " + options.camera.calibration) +
+                        (options.camera.stereo ? "+stereo" : ""),
                     nrslam::FormatFixed(summary.depth_min_mm, 1), nrslam::FormatFixed(summary.depth_max_mm, 1),
                     nrslam::FormatFixed(summary.render_ms_per_frame, 1),
                     nrslam::FormatFixed(summary.write_ms_per_frame, 1)});

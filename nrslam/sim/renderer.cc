@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "nrslam/io/camera_file.h"
+#include "nrslam/util/error.h"
 #include "nrslam/util/random.h"
 
 namespace nrslam {
@@ -14,6 +16,7 @@ constexpr int kDisplayTableSize = 4096;
 }  // namespace
 
 Camera MakeSimCamera(const SimCameraOptions& options) {
+  if (!options.calibration.empty()) return ReadCameraFile(options.calibration);
   const double cx = 0.5 * (options.width - 1), cy = 0.5 * (options.height - 1);
   if (options.model == "pinhole") {
     const double f = 0.5 * options.width / std::tan(0.5 * options.fov_deg * M_PI / 180.0);
@@ -37,8 +40,15 @@ Renderer::Renderer(const SimOptions& options)
       threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {
   camera_.Check();
   const int width = camera_.width(), height = camera_.height();
-  const bool fisheye = camera_.model() == CameraModelId::kKannalaBrandt;
-  const double fov_limit = fisheye ? 0.5 * options.camera.fisheye_fov_deg * M_PI / 180.0 : M_PI / 2;
+  const bool fisheye = camera_.model() != CameraModelId::kPinhole;
+  if (options.camera.stereo && fisheye) {
+    throw Error("sim camera: stereo needs a pinhole camera (a rectified pair); the calibration is " +
+                camera_.model_name());
+  }
+  // The simulator's own fisheye ends at its image circle; a calibration wherever its model does.
+  const double fov_limit = !fisheye                             ? M_PI / 2
+                           : options.camera.calibration.empty() ? 0.5 * options.camera.fisheye_fov_deg * M_PI / 180.0
+                                                                : camera_.max_theta();
   bearings_.resize(static_cast<size_t>(width) * height);
   vignetting_.resize(bearings_.size());
   double widest = 0.0;
@@ -120,7 +130,8 @@ RenderedView Renderer::RenderView(const Rigid3& world_from_camera, int frame_ind
         const SurfaceHit& hit = hits[i];
         Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
         if (hit.valid && hit.distance > 0) {
-          depth_row[x] = static_cast<float>(hit.distance * bearings_[k].z());
+          // A ray 90° or more off the axis (a calibrated fisheye) has no z-depth: 0, none.
+          depth_row[x] = static_cast<float>(std::max(0.0, hit.distance * bearings_[k].z()));
           const double cos_incidence = std::abs(hit.normal.dot(directions[i]));
           const double irradiance = look.light_power / (hit.distance * hit.distance);
           const double footprint = hit.distance * inverse_focal / std::max(cos_incidence, 0.3);

@@ -30,7 +30,7 @@ struct RenderedFrame {
 };
 
 // The camera the options describe (pinhole from the horizontal FOV; fisheye with its image
-// circle filling the width).
+// circle filling the width), or the one in their calibration file (throws Error if unreadable).
 Camera MakeSimCamera(const SimCameraOptions& options);
 
 class Renderer {

@@ -23,6 +23,10 @@ struct SimCameraOptions {
   double fisheye_k1 = 0.002;
   bool stereo = false;            // also render a rectified right camera (pinhole only)
   double baseline_mm = 5.0;       // stereo baseline, mm
+  // A calibration file to render with instead of the model above (a camera JSON, a
+  // sequence.json or OCamCalib's calib_results.txt): your own endoscope's lens. Its image size
+  // replaces width and height; every pixel whose ray the model defines is rendered.
+  std::string calibration;
   void Check() const;
 };
 
@@ -100,7 +104,7 @@ struct SimOptions {
 };
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SimCameraOptions, model, width, height, fov_deg, fisheye_fov_deg, fisheye_k0,
-                                                fisheye_k1, stereo, baseline_mm)
+                                                fisheye_k1, stereo, baseline_mm, calibration)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(DeformationOptions, amplitude_mm, omega_rad_s, lambda_mm)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ColonOptions, radius_mean_mm, radius_variation_mm,
                                                 radius_wavelength_mm, bend_amplitude_mm, bend_wavelength_mm,
