@@ -16,7 +16,7 @@ namespace {
 constexpr int kSubpixelBits = 4;  // cv::circle takes fixed-point centres: sub-pixel positions stay sub-pixel
 const cv::Scalar kOutline(0, 0, 0);
 const cv::Scalar kUnscored(160, 160, 160);
-constexpr double kNoDepth = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNotScored = std::numeric_limits<double>::quiet_NaN();
 
 cv::Point FixedPoint(const cv::Point2d& pixel) {
   constexpr double kOne = 1 << kSubpixelBits;
@@ -79,34 +79,35 @@ ErrorView DrawErrorView(const cv::Mat& bgr, const cv::Mat& depth_mm, const Frame
     for (const auto& [id, point] : points) frame_points.push_back(point);
     view.evaluation = EvaluateFrame(frame_points, depth_mm, evaluation);
   }
-  // Without a scale nothing is scored, and a frame with a scale has depth to sample.
-  std::vector<double> truths;
-  double squared_relative_error = 0;
+  // Each point's relative error, NaN where it is not scored. Without a scale nothing is, and a
+  // frame with a scale has depth to sample.
+  std::vector<double> relative_errors;
+  double squared_sum = 0;
   int scored = 0;
   for (const auto& [id, point] : points) {
-    truths.push_back(view.evaluation.evaluated ? SampleDepth(depth_mm, point.pixel).value_or(kNoDepth) : kNoDepth);
-    if (std::isnan(truths.back()) || !std::isfinite(point.depth)) continue;
-    const double relative_error = (view.evaluation.scale * point.depth - truths.back()) / truths.back();
-    squared_relative_error += relative_error * relative_error;
+    const double truth = view.evaluation.evaluated ? SampleDepth(depth_mm, point.pixel).value_or(kNotScored) : kNotScored;
+    const double error = (view.evaluation.scale * point.depth - truth) / truth;
+    relative_errors.push_back(std::isfinite(error) ? error : kNotScored);  // no truth, or no finite estimate
+    if (std::isnan(relative_errors.back())) continue;
+    squared_sum += relative_errors.back() * relative_errors.back();
     ++scored;
   }
   constexpr double kLeastAutomaticScale = 0.005;
   view.full_scale_error = options.full_scale_error > 0 ? options.full_scale_error
-                          : scored > 0 ? std::max(kLeastAutomaticScale, 3 * std::sqrt(squared_relative_error / scored))
+                          : scored > 0 ? std::max(kLeastAutomaticScale, 3 * std::sqrt(squared_sum / scored))
                                        : kLeastAutomaticScale;
   cv::Mat colour_panel = bgr.clone();
   cv::Mat depth_panel = has_depth ? ColourDepth(depth_mm, options.near_mm, options.far_mm) : cv::Mat();
-  auto truth = truths.begin();
+  auto relative_error = relative_errors.begin();
   for (const auto& [id, point] : points) {
-    const double true_depth = *truth++;
-    if (std::isnan(true_depth) || !std::isfinite(point.depth)) {
+    const double error = *relative_error++;
+    if (std::isnan(error)) {
       DrawRing(colour_panel, point.pixel, options.point_radius_px);
       continue;
     }
-    const double scaled = view.evaluation.scale * point.depth;
-    DrawDisc(colour_panel, point.pixel, options.point_radius_px,
-             ErrorColour((scaled - true_depth) / true_depth, view.full_scale_error));
-    DrawDisc(depth_panel, point.pixel, options.point_radius_px, DepthColour(scaled, options.near_mm, options.far_mm));
+    DrawDisc(colour_panel, point.pixel, options.point_radius_px, ErrorColour(error, view.full_scale_error));
+    DrawDisc(depth_panel, point.pixel, options.point_radius_px,
+             DepthColour(view.evaluation.scale * point.depth, options.near_mm, options.far_mm));
   }
   if (has_depth) {
     cv::hconcat(colour_panel, depth_panel, view.image);
