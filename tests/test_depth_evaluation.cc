@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "nrslam/eval/common_points.h"
 #include "nrslam/eval/depth_evaluation.h"
@@ -200,7 +201,7 @@ TEST(CommonPoints, AnIdThatNamesDifferentTracksInTheTwoRunsIsNotCommon) {
   EXPECT_GT(comparison.a_own.rmse_mm, 1.0);
 }
 
-// A 80×60 frame of grey at 50 mm, with no depth on its first 10 columns. 40 points at z = 5
+// A 80×60 frame of grey at 50 mm, with no depth on its first 10 columns. 39 points at z = 5
 // fix the scale at 10 (the two off ones fall in the trimmed 5 %).
 class ErrorViewTest : public ::testing::Test {
  protected:
@@ -212,9 +213,10 @@ class ErrorViewTest : public ::testing::Test {
     }
     points_[kTooDeep].depth = 6.5;     // 65 mm after scaling: 30 % too deep
     points_[kTooShallow].depth = 3.5;  // 35 mm: 30 % too shallow
+    points_[kNoEstimate].depth = std::numeric_limits<double>::infinity();
     points_[kNoTruth] = {cv::Point2d(4.25, 30.5), 5.0};
   }
-  static constexpr int64_t kTooDeep = 8, kTooShallow = 20, kRight = 30, kNoTruth = 100;
+  static constexpr int64_t kTooDeep = 8, kTooShallow = 20, kRight = 30, kNoEstimate = 33, kNoTruth = 100;
   cv::Vec3b At(const cv::Mat& image, int64_t id, int panel_offset = 0) const {
     const cv::Point2d pixel = points_.at(id).pixel;
     return image.at<cv::Vec3b>(static_cast<int>(std::lround(pixel.y)),
@@ -234,13 +236,14 @@ TEST_F(ErrorViewTest, EachPointIsColouredByItsScaledDepthError) {
   EXPECT_DOUBLE_EQ(view.evaluation.scale, expected.scale);
   EXPECT_DOUBLE_EQ(view.evaluation.rmse_mm, expected.rmse_mm);
   EXPECT_NEAR(view.evaluation.scale, 10.0, 1e-12);
-  EXPECT_EQ(view.evaluation.points_without_groundtruth, 1);
+  EXPECT_EQ(view.evaluation.points_without_groundtruth, 2);  // no truth, and no finite estimate
 
   ASSERT_EQ(view.image.size(), cv::Size(160, 60));  // colour | depth
   EXPECT_EQ(At(view.image, kRight), cv::Vec3b(255, 255, 255));
   EXPECT_EQ(At(view.image, kTooDeep), cv::Vec3b(0, 0, 255));     // BGR: red
   EXPECT_EQ(At(view.image, kTooShallow), cv::Vec3b(255, 0, 0));  // blue
   EXPECT_EQ(At(view.image, kNoTruth), cv::Vec3b(100, 100, 100)) << "a ring leaves the pixel under it visible";
+  EXPECT_EQ(At(view.image, kNoEstimate), cv::Vec3b(100, 100, 100));
 
   // Depth panel: a right point has the background's colour, a wrong one does not.
   const cv::Vec3b background = ColourDepth(depth_, 10, 120).at<cv::Vec3b>(30, 50);
@@ -251,11 +254,11 @@ TEST_F(ErrorViewTest, EachPointIsColouredByItsScaledDepthError) {
   EXPECT_EQ(At(view.image, kNoTruth, 80), cv::Vec3b(0, 0, 0)) << "no depth there: black, and no point drawn";
   EXPECT_DOUBLE_EQ(view.full_scale_error, 0.25);
 
-  // Full colour from the frame's own errors: three times their rms over the 42 scored points.
+  // Full colour from the frame's own errors: three times their rms over the 41 scored points.
   ErrorViewOptions automatic;
   automatic.full_scale_error = 0;
   const ErrorView scaled = DrawErrorView(bgr_, depth_, points_, EvaluationOptions(), automatic);
-  EXPECT_NEAR(scaled.full_scale_error, 3 * std::sqrt(2 * 0.3 * 0.3 / 42), 1e-12);
+  EXPECT_NEAR(scaled.full_scale_error, 3 * std::sqrt(2 * 0.3 * 0.3 / 41), 1e-12);
   EXPECT_EQ(At(scaled.image, kTooDeep), cv::Vec3b(0, 0, 255));
 }
 
