@@ -121,11 +121,8 @@ Eigen::Vector3d Camera::Unproject(const Eigen::Vector2d& pixel) const {
 Eigen::Matrix<double, 2, 3> Camera::ProjectionJacobian(const Eigen::Vector3d& point) const {
   using Jet = ceres::Jet<double, 3>;
   const Jet point_jet[3] = {Jet(point.x(), 0), Jet(point.y(), 1), Jet(point.z(), 2)};
-  std::vector<Jet> params_jet(params_.begin(), params_.end());
   Jet pixel_jet[2];
-  VisitCameraModel(model_, [&](auto model) {
-    return decltype(model)::Project(params_jet.data(), point_jet, pixel_jet);
-  });
+  VisitCameraModel(model_, [&](auto model) { return decltype(model)::Project(params_.data(), point_jet, pixel_jet); });
   Eigen::Matrix<double, 2, 3> jacobian;
   jacobian.row(0) = pixel_jet[0].v.transpose();
   jacobian.row(1) = pixel_jet[1].v.transpose();

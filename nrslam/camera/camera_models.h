@@ -1,4 +1,5 @@
-// camera: the projection models, as stateless structs templated on the scalar.
+// camera: the projection models, as stateless structs templated on the scalar of the point
+// (the intrinsics are constants: no residual optimises them, so they stay plain doubles).
 //
 // Pixel convention: (0, 0) is the centre of the top-left pixel (OpenCV's), u to the right,
 // v down; camera frame x right, y down, z forward. Unproject returns a unit bearing, for
@@ -21,7 +22,7 @@ struct PinholeModel {
 
   // False for points at or behind the image plane.
   template <typename T>
-  static bool Project(const T* params, const T* point, T* pixel) {
+  static bool Project(const double* params, const T* point, T* pixel) {
     if (!(point[2] > T(0))) return false;
     const T inverse_z = T(1) / point[2];
     pixel[0] = params[0] * point[0] * inverse_z + params[2];
@@ -43,7 +44,7 @@ struct KannalaBrandtModel {
   static constexpr const char* kName = "kannala_brandt";
 
   template <typename T>
-  static T Distort(const T* params, const T& theta) {
+  static T Distort(const double* params, const T& theta) {
     const T theta2 = theta * theta;
     return theta * (T(1) + theta2 * (params[4] + theta2 * (params[5] + theta2 * (params[6] + theta2 * params[7]))));
   }
@@ -51,7 +52,7 @@ struct KannalaBrandtModel {
   // Defined for every direction but the backward axis; whether θ is inside the lens's
   // field of view is the Camera's business (Camera::max_theta()).
   template <typename T>
-  static bool Project(const T* params, const T* point, T* pixel) {
+  static bool Project(const double* params, const T* point, T* pixel) {
     using std::atan2;
     using std::sqrt;
     const T rho2 = point[0] * point[0] + point[1] * point[1];
@@ -116,26 +117,26 @@ struct OcamModel {
 
   // invpol(t) and its derivative, by Horner.
   template <typename T>
-  static T Inverse(const T* params, const T& t) {
+  static T Inverse(const double* params, const T& t) {
     T value(0);
     for (int i = kMaxInverse - 1; i >= 0; --i) value = value * t + params[kInverseOffset + i];
     return value;
   }
   template <typename T>
-  static T InverseDerivative(const T* params, const T& t) {
+  static T InverseDerivative(const double* params, const T& t) {
     T value(0);
-    for (int i = kMaxInverse - 1; i >= 1; --i) value = value * t + T(double(i)) * params[kInverseOffset + i];
+    for (int i = kMaxInverse - 1; i >= 1; --i) value = value * t + i * params[kInverseOffset + i];
     return value;
   }
   // Pixel distance from the centre (before the affine part) of a ray φ off the axis.
   template <typename T>
-  static T Radius(const T* params, const T& phi) {
-    const T axis(-M_PI / 2);
-    return Inverse(params, phi + axis) - Inverse(params, axis);
+  static T Radius(const double* params, const T& phi) {
+    constexpr double kAxis = -M_PI / 2;
+    return Inverse(params, phi + kAxis) - Inverse(params, kAxis);
   }
 
   template <typename T>
-  static bool Project(const T* params, const T* point, T* pixel) {
+  static bool Project(const double* params, const T* point, T* pixel) {
     using std::atan2;
     using std::sqrt;
     const T& along_rows = point[1];
@@ -144,7 +145,7 @@ struct OcamModel {
     T scale;  // ρ / ‖(x, y)‖
     if (norm2 < T(1e-20) * point[2] * point[2]) {
       if (!(point[2] > T(0))) return false;
-      scale = InverseDerivative(params, T(-M_PI / 2)) / point[2];
+      scale = InverseDerivative(params, -M_PI / 2) / point[2];
     } else {
       const T norm = sqrt(norm2);
       scale = Radius(params, atan2(norm, point[2])) / norm;

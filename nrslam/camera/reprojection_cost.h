@@ -31,10 +31,8 @@ class ProjectionResidual {
   template <typename T>
   bool Evaluate(const T* pose, const Eigen::Matrix<T, 3, 1>& world_point, T* residual) const {
     const Eigen::Matrix<T, 3, 1> camera_point = TransformPoint(pose, world_point);
-    T params[Model::kNumParams];
-    for (int i = 0; i < Model::kNumParams; ++i) params[i] = T(params_[i]);
     T pixel[2];
-    if (!Model::Project(params, camera_point.data(), pixel)) return false;  // behind the camera
+    if (!Model::Project(params_, camera_point.data(), pixel)) return false;  // behind the camera
     residual[0] = (T(observed_.x()) - pixel[0]) * inverse_sigma_;
     residual[1] = (T(observed_.y()) - pixel[1]) * inverse_sigma_;
     return true;
