@@ -2,9 +2,13 @@
 
 #include <ceres/jet.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
+#include <utility>
 #include <sstream>
 
 #include "nrslam/util/error.h"
@@ -32,22 +36,69 @@ Camera Camera::KannalaBrandt(int width, int height, double fx, double fy, double
   return camera;
 }
 
+namespace {
+
+// What OCamCalib's findinvpoly does for a calibration that gives only ss: the inverse
+// polynomial least-squares fitted to the direct one's rays out to the image's farthest corner,
+// its degree raised until it is within kFitPx everywhere there (or as close as kMaxInverse
+// terms get; Check() then judges the result). `params` holds the affine part and ss.
+std::vector<double> FitInversePolynomial(const std::vector<double>& params, int width, int height) {
+  constexpr double kFitPx = 0.01;
+  constexpr int kSamples = 1000;
+  double farthest = 0.0;
+  for (const auto& [u, v] : {std::pair(0.0, 0.0), std::pair(width - 1.0, 0.0), std::pair(0.0, height - 1.0),
+                             std::pair(width - 1.0, height - 1.0)}) {
+    farthest = std::max(farthest, OcamModel::Unaffine(params.data(), u, v).norm());
+  }
+  // Samples of (s, ρ), s = t / (π/2) ∈ [-1, ...) keeping the powers of the basis near 1.
+  std::vector<double> scaled_angle, radius;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double rho = farthest * i / kSamples;
+    double z = 0.0;
+    for (int k = OcamModel::kMaxDirect - 1; k >= 0; --k) z = z * rho + params[OcamModel::kDirectOffset + k];
+    scaled_angle.push_back((std::atan2(rho, -z) - M_PI / 2) / (M_PI / 2));
+    radius.push_back(rho);
+  }
+  const Eigen::Map<const Eigen::VectorXd> target(radius.data(), static_cast<Eigen::Index>(radius.size()));
+  std::vector<double> best;
+  double best_error = std::numeric_limits<double>::infinity();
+  for (int terms = 3; terms <= OcamModel::kMaxInverse; ++terms) {
+    Eigen::MatrixXd basis(static_cast<Eigen::Index>(radius.size()), terms);
+    for (Eigen::Index row = 0; row < basis.rows(); ++row) {
+      for (int k = 0; k < terms; ++k) basis(row, k) = std::pow(scaled_angle[row], k);
+    }
+    const Eigen::VectorXd scaled = basis.colPivHouseholderQr().solve(target);
+    const double error = (basis * scaled - target).cwiseAbs().maxCoeff();
+    if (!(error < best_error)) continue;
+    best_error = error;
+    best.resize(terms);
+    for (int k = 0; k < terms; ++k) best[k] = scaled[k] / std::pow(M_PI / 2, k);
+    if (error < kFitPx) break;
+  }
+  return best;
+}
+
+}  // namespace
+
 Camera Camera::Ocam(int width, int height, double cx, double cy, double c, double d, double e,
                     const std::vector<double>& direct, const std::vector<double>& inverse) {
   Camera camera;
   camera.model_ = CameraModelId::kOcam;
   camera.width_ = width;
   camera.height_ = height;
-  if (direct.empty() || direct.size() > OcamModel::kMaxDirect || inverse.size() < 2 ||
+  if (direct.empty() || direct.size() > OcamModel::kMaxDirect || inverse.size() == 1 ||
       inverse.size() > OcamModel::kMaxInverse) {
     std::ostringstream text;
     text << "camera: ocam needs 1 to " << OcamModel::kMaxDirect << " direct (ss) and 2 to " << OcamModel::kMaxInverse
-         << " inverse (invpol) coefficients, got " << direct.size() << " and " << inverse.size();
+         << " inverse (invpol) coefficients (or none, to fit them), got " << direct.size() << " and " << inverse.size();
     throw Error(text.str());
   }
   camera.params_.assign(OcamModel::kNumParams, 0.0);
   std::copy(direct.begin(), direct.end(), camera.params_.begin() + OcamModel::kDirectOffset);
-  std::copy(inverse.begin(), inverse.end(), camera.params_.begin() + OcamModel::kInverseOffset);
+  const double affine[] = {cx, cy, c, d, e};
+  std::copy(std::begin(affine), std::end(affine), camera.params_.begin() + 2);
+  const std::vector<double> fitted = inverse.empty() ? FitInversePolynomial(camera.params_, width, height) : inverse;
+  std::copy(fitted.begin(), fitted.end(), camera.params_.begin() + OcamModel::kInverseOffset);
   const double focal = OcamModel::InverseDerivative(camera.params_.data(), -M_PI / 2);
   const double derived[] = {focal, focal * c, cx, cy, c, d, e};
   std::copy(std::begin(derived), std::end(derived), camera.params_.begin());
@@ -242,10 +293,11 @@ void from_json(const nlohmann::json& j, Camera& camera) {
     const int height = j.at("height").get<int>();
     const double cx = j.at("cx").get<double>(), cy = j.at("cy").get<double>();
     if (model == OcamModel::kName) {
-      require({"ss", "invpol"});
+      require({"ss"});
       // No affine part given: the identity, as OCamCalib starts from.
       camera = Camera::Ocam(width, height, cx, cy, j.value("c", 1.0), j.value("d", 0.0), j.value("e", 0.0),
-                            j.at("ss").get<std::vector<double>>(), j.at("invpol").get<std::vector<double>>());
+                            j.at("ss").get<std::vector<double>>(),
+                            j.value("invpol", std::vector<double>()));  // none: fitted to ss
       camera.Check();
       return;
     }

@@ -20,6 +20,7 @@ class Camera {
                               const Eigen::Vector4d& k);
   // OCamCalib's model (camera_models.h): centre at column cx, row cy; `direct` is ss and
   // `inverse` is invpol, lowest order first, at most OcamModel::kMaxDirect / kMaxInverse terms.
+  // An empty `inverse` is fitted to `direct` over the image (calibrations that give only ss).
   static Camera Ocam(int width, int height, double cx, double cy, double c, double d, double e,
                      const std::vector<double>& direct, const std::vector<double>& inverse);
 
