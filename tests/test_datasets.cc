@@ -9,10 +9,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
+#include "camera_fixtures.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -167,6 +169,40 @@ TEST(DatasetImport, C3vdDepthScaleAndBothPoseOrders) {
     fs::remove_all(in);
     fs::remove_all(out);
   }
+}
+
+// C3VD's colonoscope is calibrated with OCamCalib: its calib_results.txt is the calibration as
+// it is (here a 64x48 fisheye written in that format).
+TEST(DatasetImport, C3vdWithItsOCamCalibResults) {
+  const fs::path in = UniqueTempFolder("c3vd_ocam_in"), out = UniqueTempFolder("c3vd_ocam_out");
+  C3vdFixture(in, false);
+  const Camera lens = OcamFromKannalaBrandt(
+      Camera::KannalaBrandt(kWidth, kHeight, 22.0, 22.3, 31.8, 23.2, Eigen::Vector4d(-0.02, 0.002, 0, 0)));
+  const nlohmann::json fields = lens;
+  std::ofstream text(in / "calib_results.txt");
+  const auto polynomial = [&](const char* key) {
+    text << fields[key].size();
+    for (double coefficient : fields[key]) text << ' ' << std::setprecision(17) << coefficient;
+    text << "\n\n";
+  };
+  text << "#polynomial coefficients for the DIRECT mapping function (ocam_model.ss in MATLAB)\n\n";
+  polynomial("ss");
+  text << "#polynomial coefficients for the inverse mapping function (ocam_model.invpol in MATLAB)\n\n";
+  polynomial("invpol");
+  text << "#center: \"row\" and \"column\", starting from 0 (C convention)\n\n" << lens.cy() << ' ' << lens.cx()
+       << "\n\n#affine parameters \"c\", \"d\", \"e\"\n\n" << fields["c"] << " 0 0\n\n"
+       << "#image size: \"height\" and \"width\"\n\n" << kHeight << ' ' << kWidth << '\n';
+  text.close();
+  ImportOptions options = Options("c3vd", in);
+  options.calibration = in / "calib_results.txt";
+  ImportDataset(options, out);
+  const SequenceReader sequence(out);
+  EXPECT_EQ(sequence.info().camera.model(), CameraModelId::kOcam);
+  EXPECT_LT((sequence.info().camera.Unproject(Eigen::Vector2d(50.3, 10.6)) - lens.Unproject(Eigen::Vector2d(50.3, 10.6)))
+                .norm(),
+            1e-9);
+  fs::remove_all(in);
+  fs::remove_all(out);
 }
 
 TEST(DatasetImport, PlainImageFolderAndVideoWithACalibration) {
