@@ -54,9 +54,7 @@ std::vector<double> FitInversePolynomial(const std::vector<double>& params, int 
   std::vector<double> scaled_angle, radius;
   for (int i = 0; i <= kSamples; ++i) {
     const double rho = farthest * i / kSamples;
-    double z = 0.0;
-    for (int k = OcamModel::kMaxDirect - 1; k >= 0; --k) z = z * rho + params[OcamModel::kDirectOffset + k];
-    scaled_angle.push_back((std::atan2(rho, -z) - M_PI / 2) / (M_PI / 2));
+    scaled_angle.push_back((std::atan2(rho, -OcamModel::Direct(params.data(), rho)) - M_PI / 2) / (M_PI / 2));
     radius.push_back(rho);
   }
   const Eigen::Map<const Eigen::VectorXd> target(radius.data(), static_cast<Eigen::Index>(radius.size()));
@@ -99,9 +97,9 @@ Camera Camera::Ocam(int width, int height, double cx, double cy, double c, doubl
   std::copy(std::begin(affine), std::end(affine), camera.params_.begin() + 2);
   const std::vector<double> fitted = inverse.empty() ? FitInversePolynomial(camera.params_, width, height) : inverse;
   std::copy(fitted.begin(), fitted.end(), camera.params_.begin() + OcamModel::kInverseOffset);
-  const double focal = OcamModel::InverseDerivative(camera.params_.data(), -M_PI / 2);
-  const double derived[] = {focal, focal * c, cx, cy, c, d, e};
-  std::copy(std::begin(derived), std::end(derived), camera.params_.begin());
+  // fx, fy in the other models' places: ρ'(0) along the columns and the rows.
+  camera.params_[0] = OcamModel::InverseDerivative(camera.params_.data(), -M_PI / 2);
+  camera.params_[1] = camera.params_[0] * c;
   camera.ComputeMaxTheta();
   return camera;
 }

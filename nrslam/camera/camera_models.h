@@ -164,13 +164,17 @@ struct OcamModel {
     return Eigen::Vector2d((row - d * column) / det, (c * column - e * row) / det);
   }
 
+  // ss(ρ): OCamCalib's z of the ray ρ px from the centre (after the affine part), by Horner.
+  static double Direct(const double* params, double rho) {
+    double z = 0.0;
+    for (int i = kMaxDirect - 1; i >= 0; --i) z = z * rho + params[kDirectOffset + i];
+    return z;
+  }
+
   // The ray OCamCalib's direct polynomial gives a pixel (unit bearing, usual frame).
   static Eigen::Vector3d DirectRay(const double* params, double u, double v) {
     const Eigen::Vector2d ab = Unaffine(params, u, v);
-    const double rho = ab.norm();
-    double z = 0.0;
-    for (int i = kMaxDirect - 1; i >= 0; --i) z = z * rho + params[kDirectOffset + i];
-    return Eigen::Vector3d(ab.y(), ab.x(), -z).normalized();
+    return Eigen::Vector3d(ab.y(), ab.x(), -Direct(params, ab.norm())).normalized();
   }
 
   static Eigen::Vector3d Unproject(const double* params, double u, double v) {

@@ -41,12 +41,6 @@ cv::Scalar ErrorColour(double relative_error, double full_scale) {
   return level >= 0 ? cv::Scalar(fade, fade, 255) : cv::Scalar(255, fade, fade);
 }
 
-cv::Scalar DepthColour(double depth_mm, double near_mm, double far_mm) {
-  const cv::Mat one(1, 1, CV_32F, cv::Scalar(depth_mm));
-  const cv::Vec3b colour = ColourDepth(one, near_mm, far_mm).at<cv::Vec3b>(0, 0);
-  return cv::Scalar(colour[0], colour[1], colour[2]);
-}
-
 }  // namespace
 
 void ErrorViewOptions::Check() const {
@@ -98,16 +92,21 @@ ErrorView DrawErrorView(const cv::Mat& bgr, const cv::Mat& depth_mm, const Frame
                                        : kLeastAutomaticScale;
   cv::Mat colour_panel = bgr.clone();
   cv::Mat depth_panel = has_depth ? ColourDepth(depth_mm, options.near_mm, options.far_mm) : cv::Mat();
-  auto relative_error = relative_errors.begin();
+  // Every point's scaled depth in the depth panel's colours, in one pass of the colour map.
+  cv::Mat scaled_depths(1, static_cast<int>(points.size()), CV_32F);
+  int index = 0;
+  for (const auto& [id, point] : points) scaled_depths.at<float>(0, index++) = view.evaluation.scale * point.depth;
+  const cv::Mat depth_colours = points.empty() ? cv::Mat() : ColourDepth(scaled_depths, options.near_mm, options.far_mm);
+  index = 0;
   for (const auto& [id, point] : points) {
-    const double error = *relative_error++;
+    const double error = relative_errors[index];
+    const cv::Vec3b depth_colour = depth_colours.at<cv::Vec3b>(0, index++);
     if (std::isnan(error)) {
       DrawRing(colour_panel, point.pixel, options.point_radius_px);
       continue;
     }
     DrawDisc(colour_panel, point.pixel, options.point_radius_px, ErrorColour(error, view.full_scale_error));
-    DrawDisc(depth_panel, point.pixel, options.point_radius_px,
-             DepthColour(view.evaluation.scale * point.depth, options.near_mm, options.far_mm));
+    DrawDisc(depth_panel, point.pixel, options.point_radius_px, cv::Scalar(depth_colour[0], depth_colour[1], depth_colour[2]));
   }
   if (has_depth) {
     cv::hconcat(colour_panel, depth_panel, view.image);
