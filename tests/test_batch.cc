@@ -366,7 +366,7 @@ TEST(Results, NeverInitialisedRunShowsDashesNotMissingGroundTruth) {
   const std::string row = table.str().substr(table.str().find("uniform"));
   EXPECT_EQ(row.find("no GT"), std::string::npos) << table.str();
   EXPECT_EQ(row.find("-1"), std::string::npos) << table.str();
-  EXPECT_TRUE(std::regex_search(row, std::regex(R"(not_initialised +- +0/30 +- +- +- +- +200\.0)"))) << table.str();
+  EXPECT_TRUE(std::regex_search(row, std::regex(R"(not_initialised +- +0/30 +- +- +- +- +- +200\.0)"))) << table.str();
 }
 
 TEST(Results, WhereAndWhyARunStoppedIsShownAndKept) {
@@ -877,6 +877,11 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   EXPECT_GT(results[0].rmse_flat_mm, 0.0);
   EXPECT_DOUBLE_EQ(read[0].rmse_flat_mm, results[0].rmse_flat_mm);
   EXPECT_LT(read[1].rmse_flat_mm, 0.0);  // failed: none recorded
+  EXPECT_GT(results[0].rmse_map_scale_mm, 0.0);
+  EXPECT_DOUBLE_EQ(read[0].rmse_map_scale_mm, results[0].rmse_map_scale_mm);
+  EXPECT_DOUBLE_EQ(read[0].rmse_median_scale_mm, results[0].rmse_median_scale_mm);
+  EXPECT_LT(read[1].rmse_map_scale_mm, 0.0);
+  EXPECT_NE(table.str().find("1 scale mm"), std::string::npos) << table.str();
 
   // The rigid run is the good run's baseline; the broken one has none.
   const std::vector<RigidComparison> comparisons = CompareWithRigid(plan, results);

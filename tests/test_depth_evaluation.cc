@@ -135,6 +135,83 @@ TEST(DepthEvaluation, SequenceAggregates) {
   EXPECT_NEAR(metrics.rmse_flat_mm, 70.0 / 3.0, 1e-12);
 }
 
+TEST(DepthEvaluation, AtAGivenScaleItTrimsButDoesNotFit) {
+  const std::vector<double> estimated = Estimates(100);
+  std::vector<double> truth;
+  for (double z : estimated) truth.push_back(30.0 * z);
+  for (int k : {3, 50, 77, 120, 121, 160, 199}) truth[k] += 500.0;  // dropped by the trimming at scale 30
+  const FrameEvaluation exact = EvaluateDepthPairsAtScale(estimated, truth, 30.0, EvaluationOptions{});
+  ASSERT_TRUE(exact.evaluated);
+  EXPECT_EQ(exact.points_kept, 190);
+  EXPECT_DOUBLE_EQ(exact.scale, 30.0);
+  EXPECT_NEAR(exact.rmse_mm, 0.0, 1e-12);
+  // At scale 33 each kept residual is 3·z: the 190 smallest are the first 190 clean points'.
+  const FrameEvaluation off = EvaluateDepthPairsAtScale(estimated, truth, 33.0, EvaluationOptions{});
+  double squared = 0.0;
+  int kept = 0;
+  for (size_t i = 0; i < estimated.size() && kept < 190; ++i) {
+    if (truth[i] != 30.0 * estimated[i]) continue;
+    squared += 9.0 * estimated[i] * estimated[i];
+    ++kept;
+  }
+  EXPECT_NEAR(off.rmse_mm, std::sqrt(squared / 190), 1e-9);
+  EXPECT_FALSE(EvaluateDepthPairsAtScale({1.0, 2.0}, {10.0, 20.0}, 10.0, EvaluationOptions{}).evaluated);
+}
+
+// A frame evaluated as EvaluateFrame leaves it: its pairs, and the map they belong to.
+FrameEvaluation FrameOfPairs(int map, const std::vector<double>& estimated, const std::vector<double>& truth) {
+  EvaluationOptions untrimmed;
+  untrimmed.keep_fraction = 1.0;
+  FrameEvaluation frame = EvaluateDepthPairs(estimated, truth, untrimmed);
+  frame.map = map;
+  frame.estimated = estimated;
+  frame.groundtruth = truth;
+  return frame;
+}
+
+TEST(DepthEvaluation, OneScalePerMapMakesAScaleDriftCount) {
+  EvaluationOptions untrimmed;
+  untrimmed.keep_fraction = 1.0;
+  const std::vector<double> z = {1, 2, 3, 4, 5};  // Σz² = 55
+  auto scaled = [&](double s) {
+    std::vector<double> truth;
+    for (double value : z) truth.push_back(s * value);
+    return truth;
+  };
+  // Map 0 drifts from scale 10 to 20: each frame alone is exact, the map's one scale is 15
+  // (least squares over both frames), leaving 5·z in each, RMSE 5·√(55/5).
+  // Map 1 keeps scale 40 and is exact at its own scale.
+  const std::vector<FrameEvaluation> frames = {FrameOfPairs(0, z, scaled(10)), FrameOfPairs(0, z, scaled(20)),
+                                               FrameOfPairs(1, z, scaled(40)), FrameOfPairs(1, z, scaled(40))};
+  EXPECT_NEAR(AggregateFrames(frames).rmse_mm, 0.0, 1e-12);
+  const OtherAlignments other = EvaluateOtherAlignments(frames, untrimmed);
+  EXPECT_EQ(other.frames_evaluated, 4);
+  EXPECT_NEAR(other.rmse_map_scale_mm, (5.0 * std::sqrt(11.0) * 2 + 0.0 * 2) / 4, 1e-9);
+  EXPECT_NEAR(other.rmse_median_scale_mm, 0.0, 1e-12);  // every frame's ratios all agree
+}
+
+TEST(DepthEvaluation, TheMedianScaleIsTheMiddleRatioOfEachFrame) {
+  // Ratios 2, 2, 2, 9, 9 (two points far off): the median ratio is 2, so the three points that
+  // agree score 0 and the two others 7·z; least squares would have pulled the scale up.
+  const std::vector<double> z = {1, 1, 1, 1, 1};
+  const std::vector<double> truth = {2, 2, 2, 9, 9};
+  EvaluationOptions untrimmed;
+  untrimmed.keep_fraction = 1.0;
+  const OtherAlignments other = EvaluateOtherAlignments({FrameOfPairs(0, z, truth)}, untrimmed);
+  EXPECT_NEAR(other.rmse_median_scale_mm, std::sqrt(2 * 49.0 / 5), 1e-12);
+  // Estimates behind the camera have no ratio: here only the positive ones vote (ratio 3).
+  const OtherAlignments behind =
+      EvaluateOtherAlignments({FrameOfPairs(0, {1, 1, 1, -1, -1}, {3, 3, 3, 3, 3})}, untrimmed);
+  EXPECT_NEAR(behind.rmse_median_scale_mm, std::sqrt(2 * 36.0 / 5), 1e-12);
+}
+
+TEST(DepthEvaluation, OtherAlignmentsNeedTheFramesPairs) {
+  FrameEvaluation frame;
+  frame.evaluated = true;  // as AggregateFrames' own test builds one: figures, no pairs
+  EXPECT_THROW(EvaluateOtherAlignments({frame}, EvaluationOptions{}), Error);
+  EXPECT_EQ(EvaluateOtherAlignments({}, EvaluationOptions{}).frames_evaluated, 0);
+}
+
 // Ground truth for the common-point tests: a slanted plane, 80 mm + 1 mm per column.
 cv::Mat SlantedPlaneDepth() {
   cv::Mat depth(40, 60, CV_32F);

@@ -130,10 +130,17 @@ TEST_F(RunSequenceTest, SummaryRmseIsRecomputableFromPointsCsvAndGroundTruth) {
     evaluations.push_back(EvaluateFrame(depth_points, reader.ReadDepthMm(frame), EvaluationOptions{}));
   }
   const SequenceMetrics recomputed = AggregateFrames(evaluations);
+  const OtherAlignments other = EvaluateOtherAlignments(evaluations, EvaluationOptions{});  // one map: the run's only
   nlohmann::json summary;
   std::ifstream(*base_ / "run" / "summary.json") >> summary;
   // points.csv stores 9 significant digits; the RMSE agrees to far better than a micrometre.
   EXPECT_NEAR(recomputed.rmse_mm, summary.at("rmse_mm").get<double>(), 1e-5);
+  EXPECT_NEAR(other.rmse_map_scale_mm, summary.at("rmse_map_scale_mm").get<double>(), 1e-5);
+  EXPECT_NEAR(other.rmse_median_scale_mm, summary.at("rmse_median_scale_mm").get<double>(), 1e-5);
+  // A map from depth is in millimetres from the start, so one scale costs little over a
+  // scale per frame; a tracker whose scale drifted would pay here.
+  EXPECT_GE(other.rmse_map_scale_mm, recomputed.rmse_mm - 1e-9);
+  EXPECT_LT(other.rmse_map_scale_mm, 2.0 * recomputed.rmse_mm);
   EXPECT_NEAR(recomputed.rmse_median_mm, summary.at("rmse_median_mm").get<double>(), 1e-5);
   EXPECT_NEAR(recomputed.rmse_pooled_mm, summary.at("rmse_pooled_mm").get<double>(), 1e-5);
   EXPECT_NEAR(recomputed.rmse_flat_mm, summary.at("rmse_flat_mm").get<double>(), 1e-5);
@@ -181,6 +188,8 @@ TEST_F(RunSequenceTest, ScoringTheRunsOwnOutputAsAnExternalResultGivesItsSummary
   EXPECT_EQ(summary.frames_evaluated, summary_->frames_evaluated);
   EXPECT_NEAR(summary.rmse_mm, summary_->rmse_mm, 1e-5);
   EXPECT_NEAR(summary.rmse_flat_mm, summary_->rmse_flat_mm, 1e-5);
+  EXPECT_NEAR(summary.rmse_map_scale_mm, summary_->rmse_map_scale_mm, 1e-5);
+  EXPECT_NEAR(summary.rmse_median_scale_mm, summary_->rmse_median_scale_mm, 1e-5);
   ASSERT_TRUE(summary.trajectory_error.evaluated);
   EXPECT_NEAR(summary.trajectory_error.rmse_mm, summary_->trajectory_error.rmse_mm, 1e-4);
   for (const char* file : {"config.json", "points.csv", "metrics.csv", "summary.json", "trajectory.tum"}) {

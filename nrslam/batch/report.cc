@@ -65,7 +65,8 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   }
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
-       << "; a map at one depth: " << FlatRmseCell(result) << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
+       << "; one scale per map: " << RecordedRmseCell(result, result.rmse_map_scale_mm) << "; a map at one depth: "
+       << RecordedRmseCell(result, result.rmse_flat_mm) << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   if (!StopText(result).empty()) html << "<p>Ended without tracking: " << EscapeXml(StopText(result)) << "</p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
@@ -224,17 +225,18 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
           "{text-align:left}td:nth-child(-n+2){white-space:nowrap}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
           "figure{margin:0}section{margin-top:28px}</style></head><body>\n<h1>nrslam evaluation</h1>\n";
   html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
-          "<th>flat mm</th><th>ATE mm</th><th>fps</th></tr>\n";
+          "<th>flat mm</th><th>1 scale mm</th><th>ATE mm</th><th>fps</th></tr>\n";
   for (const RunResult& r : results) {
     const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
     html << "<tr><td><a href=\"#" << EscapeXml(Slug(r)) << "\">" << EscapeXml(key) << "</a></td>";
     if (r.status == "failed") {
-      html << "<td class=\"failed\">FAILED</td><td colspan=\"7\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
+      html << "<td class=\"failed\">FAILED</td><td colspan=\"8\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
       continue;
     }
     html << "<td>" << r.status << "</td><td>" << InitFrameCell(r) << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
-         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << FlatRmseCell(r) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
+         << RmseCell(r, r.rmse_median_mm) << "</td><td>" << RecordedRmseCell(r, r.rmse_flat_mm) << "</td><td>"
+         << RecordedRmseCell(r, r.rmse_map_scale_mm) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
   html << "</table>\n<p>Code: " << EscapeXml(DescribeRevisions(results)) << "</p>\n" << SweepSection(results) << RigidSection(comparisons) << SeedSection(seed_groups);

@@ -25,6 +25,12 @@ std::string CsvField(const std::string& text) {
 
 namespace {
 
+// json[key] when it is a number; `fallback` when it is missing or null (not recorded).
+double NumberOr(const Json& json, const char* key, double fallback) {
+  const auto found = json.find(key);
+  return found != json.end() && found->is_number() ? found->get<double>() : fallback;
+}
+
 // The figures a run's summary.json and a results.json row share, under the same keys.
 void ReadFigures(const Json& json, RunResult* result) {
   result->init_frame = json.value("init_frame", -1);
@@ -34,11 +40,11 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
-  const auto flat = json.find("rmse_flat_mm");
-  result->rmse_flat_mm = flat != json.end() && flat->is_number() ? flat->get<double>() : -1.0;
+  result->rmse_flat_mm = NumberOr(json, "rmse_flat_mm", -1.0);
+  result->rmse_map_scale_mm = NumberOr(json, "rmse_map_scale_mm", -1.0);
+  result->rmse_median_scale_mm = NumberOr(json, "rmse_median_scale_mm", -1.0);
   result->fps = json.value("fps", 0.0);
-  const auto ate = json.find("ate_rmse_mm");
-  result->ate_mm = ate != json.end() && ate->is_number() ? ate->get<double>() : -1.0;
+  result->ate_mm = NumberOr(json, "ate_rmse_mm", -1.0);
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
     result->stop_reason = reason->get<std::string>();
@@ -187,8 +193,8 @@ std::string RmseCell(const RunResult& result, double rmse_mm) {
   return result.frames_tracked > 0 ? "no GT" : "-";  // with no frame tracked there was nothing to score
 }
 
-std::string FlatRmseCell(const RunResult& result) {
-  return result.rmse_flat_mm >= 0 ? RmseCell(result, result.rmse_flat_mm) : "-";
+std::string RecordedRmseCell(const RunResult& result, double rmse_mm) {
+  return rmse_mm >= 0 ? RmseCell(result, rmse_mm) : "-";
 }
 
 std::string InitFrameCell(const RunResult& result) {
@@ -239,14 +245,27 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
   return results;
 }
 
+namespace {
+// A figure that may not have been recorded (negative) as JSON: null then.
+Json RecordedNumber(double value) { return value >= 0 ? Json(value) : Json(); }
+// The same as a CSV field: empty then.
+std::string RecordedField(double value) {
+  std::ostringstream field;
+  if (value >= 0) field << value;
+  return field.str();
+}
+}  // namespace
+
 Json ToJson(const std::vector<RunResult>& results) {
   Json rows = Json::array();
   for (const RunResult& r : results) {
     rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
-                    {"rmse_flat_mm", r.rmse_flat_mm >= 0 ? Json(r.rmse_flat_mm) : Json()},
-                    {"ate_rmse_mm", r.ate_mm >= 0 ? Json(r.ate_mm) : Json()}, {"fps", r.fps}, {"run_folder", r.run_folder},
+                    {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
+                    {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
+                    {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
+                    {"ate_rmse_mm", RecordedNumber(r.ate_mm)}, {"fps", r.fps}, {"run_folder", r.run_folder},
                     {"revision", r.revision.empty() ? Json() : Json(r.revision)},
                     {"code", r.code.empty() ? Json() : Json(r.code)},
                     {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
@@ -284,14 +303,12 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
-         "rmse_flat_mm,ate_rmse_mm,fps,revision,code,error\n";
+         "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
-        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ',';
-    if (r.rmse_flat_mm >= 0) csv << r.rmse_flat_mm;  // empty when not recorded
-    csv << ',';
-    if (r.ate_mm >= 0) csv << r.ate_mm;  // empty without a trajectory error
-    csv << ',' << r.fps << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
+        << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
+        << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
 }
 
@@ -304,17 +321,20 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   for (const RunResult& r : results) swept |= !r.label.empty();
   std::vector<std::string> header = {"sequence"};
   if (swept) header.push_back("sweep point");
-  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "flat mm", "ATE mm", "fps"}) header.push_back(column);
+  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "flat mm", "1 scale mm", "ATE mm", "fps"}) {
+    header.push_back(column);
+  }
   TextTable table(header);
   for (const RunResult& r : results) {
     std::vector<std::string> row = {r.sequence};
     if (swept) row.push_back(r.label);
     if (r.status == "failed") {
-      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
+      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
     } else {
       row.insert(row.end(), {r.status, InitFrameCell(r),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
-                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), FlatRmseCell(r), AteCell(r.ate_mm),
+                             RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), RecordedRmseCell(r, r.rmse_flat_mm),
+                             RecordedRmseCell(r, r.rmse_map_scale_mm), AteCell(r.ate_mm),
                              r.fps > 0 ? FormatFixed(r.fps, 1) : "-"});  // an external result has none
     }
     table.AddRow(row);

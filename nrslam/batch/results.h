@@ -23,6 +23,9 @@ struct RunResult {
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
   double rmse_flat_mm = -1;         // what a map at one depth scores on the same points; negative: not recorded
+  // The same frames at one scale per map (its drift counts) and at each frame's median ratio
+  // (eval/depth_evaluation.h, OtherAlignments); negative: not recorded.
+  double rmse_map_scale_mm = -1, rmse_median_scale_mm = -1;
   std::string run_folder;
   std::string revision;             // the code that made the run (its config.json); "" when not recorded
   std::string code;                 // that code's fingerprint (CodeFingerprint()); "" when not recorded
@@ -78,8 +81,9 @@ std::string StopText(const RunResult& result);
 // An RMSE figure of `result` as a table shows it: "no GT" when frames were tracked but none had
 // ground truth, "-" when no frame was tracked.
 std::string RmseCell(const RunResult& result, double rmse_mm);
-// A run's flat-map RMSE as a table shows it: "-" for results written before it was recorded.
-std::string FlatRmseCell(const RunResult& result);
+// An RMSE that older results may lack (the flat map's, the map-scale one) as a table shows
+// it: "-" when not recorded (negative).
+std::string RecordedRmseCell(const RunResult& result, double rmse_mm);
 // The frame a run initialised at, "-" when it never did.
 std::string InitFrameCell(const RunResult& result);
 // A trajectory error (a run's or a mean) as a table shows it: "-" when there was none (negative).

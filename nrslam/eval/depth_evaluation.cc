@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
+#include <utility>
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
@@ -37,33 +39,69 @@ std::optional<double> SampleDepth(const cv::Mat& depth_mm, const cv::Point2d& pi
   return (1 - ay) * ((1 - ax) * d00 + ax * d01) + ay * ((1 - ax) * d10 + ax * d11);
 }
 
-FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
-                                   const EvaluationOptions& options) {
+namespace {
+
+void CheckPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth) {
   if (estimated.size() != groundtruth.size()) throw Error("EvaluateDepthPairs: size mismatch");
-  FrameEvaluation result;
-  result.points_used = static_cast<int>(estimated.size());
   for (size_t i = 0; i < estimated.size(); ++i) {
     if (!std::isfinite(estimated[i]) || !std::isfinite(groundtruth[i])) {
       throw Error("EvaluateDepthPairs: non-finite depth at point " + std::to_string(i));
     }
   }
+}
+
+size_t KeptCount(size_t count, const EvaluationOptions& options) {
+  return std::max<size_t>(1, static_cast<size_t>(std::floor(options.keep_fraction * count)));
+}
+
+// Puts the indices of the `keep` smallest squared residuals at `scale` first in `order`.
+void SelectSmallestResiduals(const std::vector<double>& estimated, const std::vector<double>& groundtruth, double scale,
+                             size_t keep, std::vector<size_t>* order) {
+  std::vector<double> squared(estimated.size());
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    const double residual = groundtruth[i] - scale * estimated[i];
+    squared[i] = residual * residual;
+  }
+  order->resize(estimated.size());
+  std::iota(order->begin(), order->end(), 0);
+  // Ties broken by index, so the kept set never depends on the sort's whims.
+  std::nth_element(order->begin(), order->begin() + (keep - 1), order->end(), [&](size_t a, size_t b) {
+    return squared[a] != squared[b] ? squared[a] < squared[b] : a < b;
+  });
+}
+
+double KeptSquaredError(const std::vector<double>& estimated, const std::vector<double>& groundtruth, double scale,
+                        const std::vector<size_t>& order, size_t keep) {
+  double sum = 0.0;
+  for (size_t k = 0; k < keep; ++k) {
+    const double residual = groundtruth[order[k]] - scale * estimated[order[k]];
+    sum += residual * residual;
+  }
+  return sum;
+}
+
+void SetScore(double scale, double kept_sum, size_t keep, FrameEvaluation* result) {
+  result->evaluated = true;
+  result->points_kept = static_cast<int>(keep);
+  result->scale = scale;
+  result->squared_error_sum = kept_sum;
+  result->rmse_mm = std::sqrt(kept_sum / keep);
+}
+
+}  // namespace
+
+FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
+                                   const EvaluationOptions& options) {
+  CheckPairs(estimated, groundtruth);
+  FrameEvaluation result;
+  result.points_used = static_cast<int>(estimated.size());
   if (result.points_used < options.min_points) return result;
-  const size_t count = estimated.size();
-  const size_t keep = std::max<size_t>(1, static_cast<size_t>(std::floor(options.keep_fraction * count)));
-  std::vector<size_t> order(count);
-  std::vector<double> squared(count);
+  const size_t keep = KeptCount(estimated.size(), options);
+  std::vector<size_t> order;
   double scale = 1.0;
   double kept_sum = 0.0;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    for (size_t i = 0; i < count; ++i) {
-      const double residual = groundtruth[i] - scale * estimated[i];
-      squared[i] = residual * residual;
-    }
-    std::iota(order.begin(), order.end(), 0);
-    // Ties broken by index, so the kept set never depends on the sort's whims.
-    std::nth_element(order.begin(), order.begin() + (keep - 1), order.end(), [&](size_t a, size_t b) {
-      return squared[a] != squared[b] ? squared[a] < squared[b] : a < b;
-    });
+    SelectSmallestResiduals(estimated, groundtruth, scale, keep, &order);
     double cross = 0.0, energy = 0.0;
     for (size_t k = 0; k < keep; ++k) {
       cross += groundtruth[order[k]] * estimated[order[k]];
@@ -71,17 +109,22 @@ FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const s
     }
     if (!(energy > 0)) return result;  // all kept estimates at zero depth: no scale
     scale = cross / energy;
-    kept_sum = 0.0;
-    for (size_t k = 0; k < keep; ++k) {
-      const double residual = groundtruth[order[k]] - scale * estimated[order[k]];
-      kept_sum += residual * residual;
-    }
+    kept_sum = KeptSquaredError(estimated, groundtruth, scale, order, keep);
   }
-  result.evaluated = true;
-  result.points_kept = static_cast<int>(keep);
-  result.scale = scale;
-  result.squared_error_sum = kept_sum;
-  result.rmse_mm = std::sqrt(kept_sum / keep);
+  SetScore(scale, kept_sum, keep, &result);
+  return result;
+}
+
+FrameEvaluation EvaluateDepthPairsAtScale(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
+                                          double scale, const EvaluationOptions& options) {
+  CheckPairs(estimated, groundtruth);
+  FrameEvaluation result;
+  result.points_used = static_cast<int>(estimated.size());
+  if (result.points_used < options.min_points || !std::isfinite(scale)) return result;
+  const size_t keep = KeptCount(estimated.size(), options);
+  std::vector<size_t> order;
+  SelectSmallestResiduals(estimated, groundtruth, scale, keep, &order);
+  SetScore(scale, KeptSquaredError(estimated, groundtruth, scale, order, keep), keep, &result);
   return result;
 }
 
@@ -102,6 +145,8 @@ FrameEvaluation EvaluateFrame(const std::vector<DepthPoint>& points, const cv::M
   result.points_without_groundtruth = without;
   if (result.evaluated) {
     result.flat_rmse_mm = EvaluateDepthPairs(std::vector<double>(groundtruth.size(), 1.0), groundtruth, options).rmse_mm;
+    result.estimated = std::move(estimated);
+    result.groundtruth = std::move(groundtruth);
   }
   return result;
 }
@@ -127,6 +172,39 @@ SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames) {
   metrics.rmse_median_mm = n % 2 ? rmses[n / 2] : 0.5 * (rmses[n / 2 - 1] + rmses[n / 2]);
   metrics.rmse_pooled_mm = std::sqrt(squared / kept);
   return metrics;
+}
+
+OtherAlignments EvaluateOtherAlignments(const std::vector<FrameEvaluation>& frames, const EvaluationOptions& options) {
+  std::map<int, std::pair<std::vector<double>, std::vector<double>>> pooled;  // per map: estimates, truths
+  for (const FrameEvaluation& frame : frames) {
+    if (!frame.evaluated) continue;
+    auto& [estimated, groundtruth] = pooled[frame.map];
+    estimated.insert(estimated.end(), frame.estimated.begin(), frame.estimated.end());
+    groundtruth.insert(groundtruth.end(), frame.groundtruth.begin(), frame.groundtruth.end());
+  }
+  std::map<int, double> map_scale;
+  for (const auto& [map, pairs] : pooled) map_scale[map] = EvaluateDepthPairs(pairs.first, pairs.second, options).scale;
+
+  std::vector<double> at_map_scale, at_median_scale;
+  for (const FrameEvaluation& frame : frames) {
+    if (!frame.evaluated) continue;
+    if (frame.estimated.empty()) throw Error("EvaluateOtherAlignments: a frame evaluated without its pairs");
+    std::vector<double> ratios;
+    for (size_t i = 0; i < frame.estimated.size(); ++i) {
+      if (frame.estimated[i] > 0) ratios.push_back(frame.groundtruth[i] / frame.estimated[i]);
+    }
+    // With no estimate in front of the camera there is no ratio; scale 0 scores them all as missing.
+    const double median_scale = ratios.empty() ? 0.0 : Median(ratios);
+    at_map_scale.push_back(
+        EvaluateDepthPairsAtScale(frame.estimated, frame.groundtruth, map_scale.at(frame.map), options).rmse_mm);
+    at_median_scale.push_back(EvaluateDepthPairsAtScale(frame.estimated, frame.groundtruth, median_scale, options).rmse_mm);
+  }
+  OtherAlignments result;
+  result.frames_evaluated = static_cast<int>(at_map_scale.size());
+  if (at_map_scale.empty()) return result;
+  result.rmse_map_scale_mm = Mean(at_map_scale);
+  result.rmse_median_scale_mm = Mean(at_median_scale);
+  return result;
 }
 
 }  // namespace nrslam

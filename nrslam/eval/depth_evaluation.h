@@ -11,6 +11,10 @@
 // depth, which is what a map without any structure scores. A depth estimate carries
 // information only where its RMSE is below that; in a tube most of the RMSE can be the spread
 // of the true depths.
+//
+// Beside the headline, two stricter alignments (design §5's extra columns): one scale per map,
+// which a per-frame scale hides the drift of, and the per-frame median ratio that monocular
+// depth benchmarks use.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -43,6 +47,11 @@ struct FrameEvaluation {
   double rmse_mm = 0.0;
   double squared_error_sum = 0.0;  // over the kept points, for pooled aggregates
   double flat_rmse_mm = 0.0;       // the same points all at one depth (EvaluateFrame only)
+  // The evaluable pairs themselves (EvaluateFrame only), for the alignments that look past one
+  // frame, and the map whose scale the estimates share (a monocular run that re-initialises
+  // starts a map of another scale); the caller sets `map`.
+  std::vector<double> estimated, groundtruth;
+  int map = 0;
 };
 
 // Bilinear sample of a depth map (CV_32F, 0 = none); nullopt unless all four taps are valid.
@@ -51,6 +60,11 @@ std::optional<double> SampleDepth(const cv::Mat& depth_mm, const cv::Point2d& pi
 // The trimmed least-squares scale and RMSE of (z_est, z_gt) pairs.
 FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
                                    const EvaluationOptions& options);
+
+// The RMSE of the pairs at a scale given, not fitted: over the smallest `keep_fraction` of
+// the squared residuals at that scale, as EvaluateDepthPairs trims.
+FrameEvaluation EvaluateDepthPairsAtScale(const std::vector<double>& estimated, const std::vector<double>& groundtruth,
+                                          double scale, const EvaluationOptions& options);
 
 // Samples the ground truth at every point, then EvaluateDepthPairs, of the estimates and of
 // the flat map.
@@ -66,5 +80,17 @@ struct SequenceMetrics {
   int frames_evaluated = 0;
 };
 SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames);
+
+// The evaluated frames (with their pairs) scored at other scales than their own, each frame's
+// RMSE trimmed as EvaluateDepthPairs trims, and averaged over the frames like rmse_mm:
+//   map scale:    one scale per map, fitted as a frame's is (trimmed least squares) to all of
+//                 that map's pairs pooled, so a map whose scale drifts pays for the drift;
+//   median scale: per frame s = median(z_gt / z_est) over the estimates in front of the camera.
+struct OtherAlignments {
+  double rmse_map_scale_mm = 0.0;
+  double rmse_median_scale_mm = 0.0;
+  int frames_evaluated = 0;
+};
+OtherAlignments EvaluateOtherAlignments(const std::vector<FrameEvaluation>& frames, const EvaluationOptions& options);
 
 }  // namespace nrslam

@@ -294,7 +294,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
                 << ",0,0,0,0,0,0,0,0,\"" << (tracked ? "" : "no estimate") << "\"\n";
   }
-  AggregateInto(&summary, evaluations, aligned);
+  AggregateInto(&summary, evaluations, aligned, evaluation);
   WriteTum(out / "trajectory.tum", trajectory);
   WriteSummaryJson(out / "summary.json", summary, {{"init", "external"}, {"mapping", nullptr}, {"mode", "external"}});
   return summary;

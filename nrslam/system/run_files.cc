@@ -42,7 +42,7 @@ std::string DescribeSummary(const RunSummary& summary) {
        << ", lost " << summary.frames_lost << ")  ";
   if (summary.frames_evaluated > 0) {
     text << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
-         << summary.rmse_flat_mm << " mm)  ";
+         << summary.rmse_flat_mm << " mm; one scale per map " << summary.rmse_map_scale_mm << " mm)  ";
   } else {
     text << "no ground truth, no RMSE  ";
   }
@@ -54,13 +54,16 @@ std::string DescribeSummary(const RunSummary& summary) {
 }
 
 void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& frames,
-                   const std::vector<TrajectorySegment>& maps) {
+                   const std::vector<TrajectorySegment>& maps, const EvaluationOptions& options) {
   const SequenceMetrics metrics = AggregateFrames(frames);
   summary->rmse_mm = metrics.rmse_mm;
   summary->rmse_median_mm = metrics.rmse_median_mm;
   summary->rmse_pooled_mm = metrics.rmse_pooled_mm;
   summary->rmse_flat_mm = metrics.rmse_flat_mm;
   summary->frames_evaluated = metrics.frames_evaluated;
+  const OtherAlignments other = EvaluateOtherAlignments(frames, options);
+  summary->rmse_map_scale_mm = other.rmse_map_scale_mm;
+  summary->rmse_median_scale_mm = other.rmse_median_scale_mm;
   summary->trajectory_error = AlignedTrajectoryError(maps);
 }
 
@@ -112,6 +115,8 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"rmse_median_mm", summary.rmse_median_mm},
                       {"rmse_pooled_mm", summary.rmse_pooled_mm},
                       {"rmse_flat_mm", summary.rmse_flat_mm},
+                      {"rmse_map_scale_mm", summary.rmse_map_scale_mm},
+                      {"rmse_median_scale_mm", summary.rmse_median_scale_mm},
                       {"frames_tracked", summary.frames_tracked},
                       {"frames_total", summary.frames_total},
                       {"frames_lost", summary.frames_lost},

@@ -26,6 +26,8 @@ inline constexpr const char* kMetricsCsvHeader =
 struct RunSummary {
   double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
   double rmse_flat_mm = 0;  // the same points all at one depth (eval/depth_evaluation.h)
+  // The same frames at one scale per map, and at each frame's median ratio (OtherAlignments).
+  double rmse_map_scale_mm = 0, rmse_median_scale_mm = 0;
   int frames_tracked = 0;  // frames with a pose after initialisation (the paper's "# Fr.")
   int frames_total = 0;
   int frames_lost = 0;
@@ -53,10 +55,11 @@ struct RunSummary {
 // outlier rejection" or "never initialised: …"; "" when `reason` is empty (it ends tracking).
 std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason);
 
-// The summary's figures: the depth aggregates of the evaluated frames and the trajectory error
-// of the tracked camera centres (one segment per map).
+// The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
+// map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked
+// camera centres (one segment per map).
 void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& frames,
-                   const std::vector<TrajectorySegment>& maps);
+                   const std::vector<TrajectorySegment>& maps, const EvaluationOptions& options);
 
 // A run folder begun: `out` and `out`/depth created, config.json written (the version, the
 // sequence's absolute path, then `config`'s keys), points.csv and metrics.csv opened with

@@ -224,6 +224,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       }
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
+        evaluation.map = maps;
         if (evaluation.evaluated) evaluations.push_back(evaluation);
       }
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
@@ -260,7 +261,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.ms_triangulation = ms_triangulation / summary.frames_total;
   summary.maps = maps;
   summary.map_points = tracker.map().size();
-  AggregateInto(&summary, evaluations, aligned_maps);
+  AggregateInto(&summary, evaluations, aligned_maps, options.evaluation);
 
   WriteTum(out / "trajectory.tum", trajectory);
   WritePly(out / "map.ply", tracker.map());
