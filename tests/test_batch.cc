@@ -946,9 +946,9 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   std::ifstream dom_stream(dom), log_stream(log);
   const std::string page((std::istreambuf_iterator<char>(dom_stream)), {});
   const std::string browser((std::istreambuf_iterator<char>(log_stream)), {});
-  // Two tracked runs: each an RMSE plot (the run and the flat map), a trajectory plot (two
-  // series) and three images.
-  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=4 series=8\""), std::string::npos)
+  // Two tracked runs: each an RMSE plot (the run and the flat map), a scale-drift plot, a
+  // trajectory plot (two series) and three images.
+  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=6 series=10\""), std::string::npos)
       << page.substr(0, 2000);
   EXPECT_NE(page.find("Failed: exit code 1"), std::string::npos);
   EXPECT_NE(page.find("<h2>Deformable against rigid</h2>"), std::string::npos);

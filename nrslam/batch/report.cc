@@ -75,6 +75,9 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
     const auto metrics = ReadCsv(run / "metrics.csv");
     PlotSeries rmse{"depth RMSE", "#1f77b4", {}, {}};
     PlotSeries flat{"a map at one depth", "#999999", {}, {}};  // runs before it was recorded have none
+    // The evaluator's scale relative to its map's first: what one scale per map pays for.
+    PlotSeries drift{"frame scale / map's first", "#2ca02c", {}, {}};
+    std::map<int, double> first_scale;  // per map
     std::vector<int> tracked;
     for (const auto& row : metrics) {
       if (row.at("state") != "tracking") continue;
@@ -85,11 +88,20 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
         flat.x.push_back(frame);
         flat.y.push_back(Number(row, "rmse_flat_mm"));
       }
+      const double scale = Number(row, "scale");
+      if (scale > 0) {  // 0: the frame was not evaluated
+        drift.x.push_back(frame);
+        drift.y.push_back(scale / first_scale.emplace(static_cast<int>(Number(row, "map")), scale).first->second);
+      }
       tracked.push_back(frame);
     }
     html << "<div class=\"plots\">"
          << LinePlotSvg(flat.x.empty() ? std::vector<PlotSeries>{rmse} : std::vector<PlotSeries>{rmse, flat},
                         {"Depth RMSE per frame", "frame", "RMSE (mm)", 520, 300, false});
+    if (!drift.x.empty()) {
+      html << LinePlotSvg({drift}, {"Scale drift: each frame's scale over its map's first", "frame", "relative scale",
+                                    520, 300, false});
+    }
     if (sequence.has_groundtruth() && std::filesystem::exists(run / "trajectory.tum")) {
       const Trajectories top = TopView(run / "trajectory.tum", sequence.groundtruth());
       html << LinePlotSvg({top.truth, top.estimate}, {"Trajectory, top view", "x (mm)", "z (mm)", 520, 300, true});
