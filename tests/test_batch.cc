@@ -417,6 +417,7 @@ TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {
         const double rmse = (sequence == "a" ? 1.0 : 2.0) * std::stod(k) + std::stod(d) / 10;  // c equals b
         RunResult r = GridRun(sequence, k, d, sequence == "c" && k == "10", rmse);
         r.ate_mm = sequence == "b" && d == "5" ? -1 : r.rmse_mm / 2;
+        r.rmse_map_scale_mm = sequence == "a" && k == "2" ? -1 : 2 * r.rmse_mm;
         results.push_back(r);
       }
     }
@@ -437,6 +438,8 @@ TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {
   // D = 3 over a and b: 2.3 10.3 4.3 20.3; every one of them has a trajectory error.
   EXPECT_DOUBLE_EQ(values[2].mean_rmse_mm, 9.3);
   EXPECT_DOUBLE_EQ(values[2].mean_ate_mm, 4.65);
+  EXPECT_LT(values[0].mean_map_scale_mm, 0);        // a at k = 2 has none recorded
+  EXPECT_DOUBLE_EQ(values[1].mean_map_scale_mm, 2 * values[1].mean_rmse_mm);
   EXPECT_EQ(values[2].short_runs, 1);
   std::stringstream table;
   PrintResults(results, table);

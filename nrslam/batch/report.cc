@@ -66,7 +66,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   html << "<p>" << result.frames_tracked << "/" << result.frames_total << " frames tracked, RMSE "
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
        << "; one scale per map: " << RecordedRmseCell(result, result.rmse_map_scale_mm) << "; a map at one depth: "
-       << RecordedRmseCell(result, result.rmse_flat_mm) << "), trajectory error " << AteCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
+       << RecordedRmseCell(result, result.rmse_flat_mm) << "), trajectory error " << MillimetresCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
   if (!StopText(result).empty()) html << "<p>Ended without tracking: " << EscapeXml(StopText(result)) << "</p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
@@ -248,7 +248,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
     html << "<td>" << r.status << "</td><td>" << InitFrameCell(r) << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
          << RmseCell(r, r.rmse_median_mm) << "</td><td>" << RecordedRmseCell(r, r.rmse_flat_mm) << "</td><td>"
-         << RecordedRmseCell(r, r.rmse_map_scale_mm) << "</td><td>" << AteCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
+         << RecordedRmseCell(r, r.rmse_map_scale_mm) << "</td><td>" << MillimetresCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
          << "</td></tr>\n";
   }
   html << "</table>\n<p>Code: " << EscapeXml(DescribeRevisions(results)) << "</p>\n" << SweepSection(results) << RigidSection(comparisons) << SeedSection(seed_groups);

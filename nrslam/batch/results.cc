@@ -201,7 +201,7 @@ std::string InitFrameCell(const RunResult& result) {
   return result.init_frame >= 0 ? std::to_string(result.init_frame) : "-";
 }
 
-std::string AteCell(double ate_mm) { return ate_mm >= 0 ? FormatFixed(ate_mm, 3) : "-"; }
+std::string MillimetresCell(double mm) { return mm >= 0 ? FormatFixed(mm, 3) : "-"; }
 
 std::string CompareCode(const std::vector<std::string>& codes_a, const std::vector<std::string>& codes_b) {
   const auto recorded = [](const std::vector<std::string>& codes) {
@@ -334,7 +334,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
       row.insert(row.end(), {r.status, InitFrameCell(r),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
                              RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), RecordedRmseCell(r, r.rmse_flat_mm),
-                             RecordedRmseCell(r, r.rmse_map_scale_mm), AteCell(r.ate_mm),
+                             RecordedRmseCell(r, r.rmse_map_scale_mm), MillimetresCell(r.ate_mm),
                              r.fps > 0 ? FormatFixed(r.fps, 1) : "-"});  // an external result has none
     }
     table.AddRow(row);
@@ -356,7 +356,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
 }
 
 std::vector<std::string> SweepSummaryHeader() {
-  return {"option", "value", "mean RMSE mm", "median mm", "mean ATE mm", "runs", "not to end",
+  return {"option", "value", "mean RMSE mm", "median mm", "mean 1 scale mm", "mean ATE mm", "runs", "not to end",
           "vs default: better / same / worse", "sign test p", "RMSE ratio to default", "signed-rank p"};
 }
 
@@ -365,7 +365,7 @@ std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
   const auto if_paired = [&v](double figure) { return v.paired ? FormatFixed(figure, 3) : std::string("-"); };
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
-          any ? AteCell(v.mean_ate_mm) : "-", std::to_string(v.runs),
+          any ? MillimetresCell(v.mean_map_scale_mm) : "-", any ? MillimetresCell(v.mean_ate_mm) : "-", std::to_string(v.runs),
           std::to_string(v.short_runs), paired, if_paired(v.against_default.SignTestP()),
           if_paired(v.against_default.GeometricMeanRatio()), if_paired(v.against_default.SignedRankP())};
 }
@@ -378,8 +378,8 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
     return *end_a == '\0' && *end_b == '\0' && x != y ? x < y : a < b;
   };
   struct Cell {
-    std::vector<double> rmse, ate;
-    bool ate_everywhere = true;
+    std::vector<double> rmse, ate, map_scale;
+    bool ate_everywhere = true, map_scale_everywhere = true;
     int short_runs = 0;
   };
   std::map<std::string, std::map<std::string, Cell, decltype(value_order)>> by_value;
@@ -392,6 +392,8 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       cell.rmse.push_back(r.rmse_mm);
       cell.ate.push_back(r.ate_mm);
       cell.ate_everywhere &= r.ate_mm >= 0;
+      cell.map_scale.push_back(r.rmse_map_scale_mm);
+      cell.map_scale_everywhere &= r.rmse_map_scale_mm >= 0;
     }
   }
   const auto has = [](const RunResult& r, const std::string& assignment) {
@@ -419,6 +421,7 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
         summary.mean_rmse_mm = Mean(cell.rmse);
         summary.median_rmse_mm = Median(cell.rmse);
         if (cell.ate_everywhere) summary.mean_ate_mm = Mean(cell.ate);
+        if (cell.map_scale_everywhere) summary.mean_map_scale_mm = Mean(cell.map_scale);
       }
       summary.is_default = value == default_value;
       summary.paired = !default_value.empty() && !summary.is_default;

@@ -86,8 +86,9 @@ std::string RmseCell(const RunResult& result, double rmse_mm);
 std::string RecordedRmseCell(const RunResult& result, double rmse_mm);
 // The frame a run initialised at, "-" when it never did.
 std::string InitFrameCell(const RunResult& result);
-// A trajectory error (a run's or a mean) as a table shows it: "-" when there was none (negative).
-std::string AteCell(double ate_mm);
+// A figure in mm that may be missing, such as a trajectory error or a mean of the map-scale
+// RMSE, as a table shows it: "-" when there is none (negative).
+std::string MillimetresCell(double mm);
 
 // Reads each run's summary.json (or failure.json) from its folder.
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan);
@@ -108,6 +109,7 @@ struct SweepValueSummary {
   int runs = 0;                  // runs averaged: one per sequence complete at every point
   double mean_rmse_mm = 0, median_rmse_mm = 0;
   double mean_ate_mm = -1;       // negative: one of those runs has no trajectory error
+  double mean_map_scale_mm = -1; // RMSE at one scale per map; negative: one of those runs has none recorded
   int short_runs = 0;            // runs at this value, over every sequence, failed or lost before the end
   // Paired with the option's default (nrslam_run's, when it is one of the swept values): each
   // run against the run of the same sequence and other swept values at the default, over the

@@ -58,7 +58,7 @@ std::vector<std::string> SideCells(const std::optional<RunResult>& run) {
   if (!run) return {"absent", "-", "-"};
   if (run->status == "failed") return {"FAILED", "-", "-"};
   return {RmseCell(*run, run->rmse_mm), std::to_string(run->frames_tracked) + "/" + std::to_string(run->frames_total),
-          AteCell(run->ate_mm)};
+          MillimetresCell(run->ate_mm)};
 }
 
 }  // namespace
@@ -153,8 +153,8 @@ void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::st
   out << "\nOver the " << diff.comparable << " run(s) tracked to the end with ground truth in both:\n";
   if (diff.comparable > 0) {
     TextTable summary({"evaluation", "mean RMSE mm", "median mm", "mean ATE mm"});
-    summary.AddRow({"A", FormatFixed(diff.mean_rmse_a_mm, 3), FormatFixed(diff.median_rmse_a_mm, 3), AteCell(diff.mean_ate_a_mm)});
-    summary.AddRow({"B", FormatFixed(diff.mean_rmse_b_mm, 3), FormatFixed(diff.median_rmse_b_mm, 3), AteCell(diff.mean_ate_b_mm)});
+    summary.AddRow({"A", FormatFixed(diff.mean_rmse_a_mm, 3), FormatFixed(diff.median_rmse_a_mm, 3), MillimetresCell(diff.mean_ate_a_mm)});
+    summary.AddRow({"B", FormatFixed(diff.mean_rmse_b_mm, 3), FormatFixed(diff.median_rmse_b_mm, 3), MillimetresCell(diff.mean_ate_b_mm)});
     summary.Print(out);
     out << "B against A, run for run (better / same / worse): " << diff.b_against_a.ToString()
         << "; two-sided sign test over the runs that moved: p = " << FormatFixed(diff.b_against_a.SignTestP(), 3)

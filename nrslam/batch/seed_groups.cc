@@ -125,7 +125,7 @@ std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
           mm(group.median_rmse_mm),
           mm(group.min_rmse_mm),
           mm(group.max_rmse_mm),
-          any ? AteCell(group.mean_ate_mm) : "-"};
+          any ? MillimetresCell(group.mean_ate_mm) : "-"};
 }
 
 void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
