@@ -767,6 +767,7 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     results.push_back(FinishedRun(plan.runs[i], frames[i]));
     results.back().ate_mm = 0.1 * static_cast<double>(i + 1);
+    results.back().rmse_map_scale_mm = results.back().rmse_mm + 1.0;
   }
   results[2].status = "lost";    // a3 lost the track: scored on its own frames, not "to end"
   results[3].status = "failed";  // a4 failed: not scored
@@ -786,6 +787,7 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
   EXPECT_DOUBLE_EQ(groups[0].min_rmse_mm, 2.0);
   EXPECT_DOUBLE_EQ(groups[0].max_rmse_mm, 9.0);
   EXPECT_NEAR(groups[0].mean_ate_mm, 0.2, 1e-12);           // 0.1, 0.2 and 0.3
+  EXPECT_DOUBLE_EQ(groups[0].mean_map_scale_mm, 6.0);        // 3, 5 and 10
   EXPECT_EQ(groups[1].name, "sim-3 rigid");
   EXPECT_EQ(groups[1].sequences, (std::vector<std::string>{"a1-rigid", "a2-rigid"}));
   EXPECT_DOUBLE_EQ(groups[1].sd_rmse_mm, 0.0);
@@ -800,7 +802,8 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
   EXPECT_EQ(cells[3], "2");
   EXPECT_EQ(cells[4], "5.000");
   EXPECT_EQ(cells[5], "3.606");
-  EXPECT_EQ(SeedGroupCells(groups[2])[9], "-");
+  EXPECT_EQ(cells[9], "6.000");
+  EXPECT_EQ(SeedGroupCells(groups[2])[10], "-");
   std::stringstream table;
   PrintSeedGroups(groups, table);
   EXPECT_NE(table.str().find("sim-3 rigid"), std::string::npos) << table.str();
@@ -813,6 +816,7 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
   EXPECT_EQ(rows[0].at("sequences"), "a1 a2 a3 a4");
   EXPECT_NEAR(Number(rows[0], "sd_rmse_mm"), std::sqrt(13.0), 1e-5);  // six significant digits, as every CSV
   EXPECT_TRUE(std::isnan(Number(rows[2], "mean_ate_mm")));
+  EXPECT_NEAR(Number(rows[0], "mean_map_scale_mm"), 6.0, 1e-9);
 
   // A sweep keeps its points apart: one group per value. Sweeping the rigid flag names it once.
   const std::vector<SeedGroup> per_value =

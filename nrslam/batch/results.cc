@@ -201,6 +201,11 @@ std::string InitFrameCell(const RunResult& result) {
   return result.init_frame >= 0 ? std::to_string(result.init_frame) : "-";
 }
 
+double MeanOfRecorded(const std::vector<double>& figures) {
+  const bool all = !figures.empty() && std::all_of(figures.begin(), figures.end(), [](double x) { return x >= 0; });
+  return all ? Mean(figures) : -1.0;
+}
+
 std::string MillimetresCell(double mm) { return mm >= 0 ? FormatFixed(mm, 3) : "-"; }
 
 std::string CompareCode(const std::vector<std::string>& codes_a, const std::vector<std::string>& codes_b) {
@@ -379,7 +384,6 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
   };
   struct Cell {
     std::vector<double> rmse, ate, map_scale;
-    bool ate_everywhere = true, map_scale_everywhere = true;
     int short_runs = 0;
   };
   std::map<std::string, std::map<std::string, Cell, decltype(value_order)>> by_value;
@@ -391,9 +395,7 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       if (!complete.at(r.sequence)) continue;
       cell.rmse.push_back(r.rmse_mm);
       cell.ate.push_back(r.ate_mm);
-      cell.ate_everywhere &= r.ate_mm >= 0;
       cell.map_scale.push_back(r.rmse_map_scale_mm);
-      cell.map_scale_everywhere &= r.rmse_map_scale_mm >= 0;
     }
   }
   const auto has = [](const RunResult& r, const std::string& assignment) {
@@ -420,8 +422,8 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
       if (!cell.rmse.empty()) {
         summary.mean_rmse_mm = Mean(cell.rmse);
         summary.median_rmse_mm = Median(cell.rmse);
-        if (cell.ate_everywhere) summary.mean_ate_mm = Mean(cell.ate);
-        if (cell.map_scale_everywhere) summary.mean_map_scale_mm = Mean(cell.map_scale);
+        summary.mean_ate_mm = MeanOfRecorded(cell.ate);
+        summary.mean_map_scale_mm = MeanOfRecorded(cell.map_scale);
       }
       summary.is_default = value == default_value;
       summary.paired = !default_value.empty() && !summary.is_default;

@@ -86,6 +86,8 @@ std::string RmseCell(const RunResult& result, double rmse_mm);
 std::string RecordedRmseCell(const RunResult& result, double rmse_mm);
 // The frame a run initialised at, "-" when it never did.
 std::string InitFrameCell(const RunResult& result);
+// The mean of figures that may each be missing (negative): negative when any is, or none given.
+double MeanOfRecorded(const std::vector<double>& figures);
 // A figure in mm that may be missing, such as a trajectory error or a mean of the map-scale
 // RMSE, as a table shows it: "-" when there is none (negative).
 std::string MillimetresCell(double mm);

@@ -49,14 +49,13 @@ std::string GroupName(const PrepareJob& render, const RunJob& run) {
 }
 
 void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
-  std::vector<double> rmse, ate;
-  bool every_ate = true;
+  std::vector<double> rmse, ate, map_scale;
   for (const RunResult* result : members) {
     if (result->status == "failed" || !result->evaluated()) continue;
     if (result->complete()) ++group->to_end;
     rmse.push_back(result->rmse_mm);
     ate.push_back(result->ate_mm);
-    every_ate = every_ate && result->ate_mm >= 0;
+    map_scale.push_back(result->rmse_map_scale_mm);
   }
   group->scored = static_cast<int>(rmse.size());
   if (rmse.empty()) return;
@@ -67,7 +66,8 @@ void Summarise(const std::vector<const RunResult*>& members, SeedGroup* group) {
   group->median_rmse_mm = Median(rmse);
   group->min_rmse_mm = *std::min_element(rmse.begin(), rmse.end());
   group->max_rmse_mm = *std::max_element(rmse.begin(), rmse.end());
-  group->mean_ate_mm = every_ate ? Mean(ate) : -1;
+  group->mean_ate_mm = MeanOfRecorded(ate);
+  group->mean_map_scale_mm = MeanOfRecorded(map_scale);
 }
 
 }  // namespace
@@ -109,7 +109,7 @@ std::vector<SeedGroup> GroupBySeed(const EvaluationPlan& plan, const std::vector
 }
 
 std::vector<std::string> SeedGroupHeader() {
-  return {"preset", "seeds", "scored", "to end", "mean RMSE mm", "sd mm", "median mm", "min mm", "max mm", "mean ATE mm"};
+  return {"preset", "seeds", "scored", "to end", "mean RMSE mm", "sd mm", "median mm", "min mm", "max mm", "mean 1 scale mm", "mean ATE mm"};
 }
 
 std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
@@ -125,6 +125,7 @@ std::vector<std::string> SeedGroupCells(const SeedGroup& group) {
           mm(group.median_rmse_mm),
           mm(group.min_rmse_mm),
           mm(group.max_rmse_mm),
+          any ? MillimetresCell(group.mean_map_scale_mm) : "-",
           any ? MillimetresCell(group.mean_ate_mm) : "-"};
 }
 
@@ -140,7 +141,7 @@ void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
 void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem::path& file) {
   std::ofstream csv(file);
   csv << "preset,seeds,sequences,runs,scored,to_end,mean_rmse_mm,sd_rmse_mm,median_rmse_mm,min_rmse_mm,max_rmse_mm,"
-         "mean_ate_mm\n";
+         "mean_map_scale_mm,mean_ate_mm\n";
   for (const SeedGroup& group : groups) {
     csv << CsvField(group.name) << ',' << Join(group.seeds, " ") << ',' << Join(group.sequences, " ") << ','
         << group.seeds.size() << ',' << group.scored << ',' << group.to_end;
@@ -149,9 +150,11 @@ void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem
       if (group.scored > 1) csv << group.sd_rmse_mm;
       csv << ',' << group.median_rmse_mm << ','
           << group.min_rmse_mm << ',' << group.max_rmse_mm << ',';
+      if (group.mean_map_scale_mm >= 0) csv << group.mean_map_scale_mm;
+      csv << ',';
       if (group.mean_ate_mm >= 0) csv << group.mean_ate_mm;
     } else {
-      csv << ",,,,,,";
+      csv << ",,,,,,,";
     }
     csv << '\n';
   }

@@ -26,7 +26,8 @@ struct SeedGroup {
   // the track is scored on fewer frames: `to_end` says how many were tracked to the end.
   int scored = 0, to_end = 0;
   double mean_rmse_mm = 0, sd_rmse_mm = 0, median_rmse_mm = 0, min_rmse_mm = 0, max_rmse_mm = 0;
-  double mean_ate_mm = -1;  // negative: a scored member has no trajectory error
+  double mean_ate_mm = -1;        // negative: a scored member has no trajectory error
+  double mean_map_scale_mm = -1;  // RMSE at one scale per map; negative: a scored member has none recorded
 };
 
 // Groups the runs of rendered presets whose render settings other than the seed and whose
