@@ -54,10 +54,12 @@ size_t KeptCount(size_t count, const EvaluationOptions& options) {
   return std::max<size_t>(1, static_cast<size_t>(std::floor(options.keep_fraction * count)));
 }
 
-// Puts the indices of the `keep` smallest squared residuals at `scale` first in `order`.
+// Puts the indices of the `keep` smallest squared residuals at `scale` first in `order`
+// (`scratch`: space for the squared residuals, reused across the trimming rounds).
 void SelectSmallestResiduals(const std::vector<double>& estimated, const std::vector<double>& groundtruth, double scale,
-                             size_t keep, std::vector<size_t>* order) {
-  std::vector<double> squared(estimated.size());
+                             size_t keep, std::vector<size_t>* order, std::vector<double>* scratch) {
+  std::vector<double>& squared = *scratch;
+  squared.resize(estimated.size());
   for (size_t i = 0; i < estimated.size(); ++i) {
     const double residual = groundtruth[i] - scale * estimated[i];
     squared[i] = residual * residual;
@@ -98,10 +100,11 @@ FrameEvaluation EvaluateDepthPairs(const std::vector<double>& estimated, const s
   if (result.points_used < options.min_points) return result;
   const size_t keep = KeptCount(estimated.size(), options);
   std::vector<size_t> order;
+  std::vector<double> scratch;
   double scale = 1.0;
   double kept_sum = 0.0;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    SelectSmallestResiduals(estimated, groundtruth, scale, keep, &order);
+    SelectSmallestResiduals(estimated, groundtruth, scale, keep, &order, &scratch);
     double cross = 0.0, energy = 0.0;
     for (size_t k = 0; k < keep; ++k) {
       cross += groundtruth[order[k]] * estimated[order[k]];
@@ -123,7 +126,8 @@ FrameEvaluation EvaluateDepthPairsAtScale(const std::vector<double>& estimated, 
   if (result.points_used < options.min_points || !std::isfinite(scale)) return result;
   const size_t keep = KeptCount(estimated.size(), options);
   std::vector<size_t> order;
-  SelectSmallestResiduals(estimated, groundtruth, scale, keep, &order);
+  std::vector<double> scratch;
+  SelectSmallestResiduals(estimated, groundtruth, scale, keep, &order, &scratch);
   SetScore(scale, KeptSquaredError(estimated, groundtruth, scale, order, keep), keep, &result);
   return result;
 }
