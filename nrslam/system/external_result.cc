@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "nrslam/io/sequence_info.h"
@@ -258,7 +259,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
       for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
       if (reader.has_depth() && !points.empty()) {
         frame_evaluation = EvaluateFrame(depth_points, reader.ReadDepthMm(frame), evaluation);
-        if (frame_evaluation.evaluated) evaluations.push_back(frame_evaluation);
+        // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
+        if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
       }
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';

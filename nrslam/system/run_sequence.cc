@@ -7,6 +7,7 @@
 #include <future>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/io/camera_file.h"
@@ -225,7 +226,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         evaluation.map = maps;
-        if (evaluation.evaluated) evaluations.push_back(evaluation);
+        // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
+        if (evaluation.evaluated) evaluations.push_back(std::move(evaluation));
       }
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
       io.Write(out / "depth" / FrameFileName(frame),
