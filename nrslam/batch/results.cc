@@ -250,15 +250,15 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
   return results;
 }
 
-namespace {
-// A figure that may not have been recorded (negative) as JSON: null then.
-Json RecordedNumber(double value) { return value >= 0 ? Json(value) : Json(); }
-// The same as a CSV field: empty then.
 std::string RecordedField(double value) {
   std::ostringstream field;
   if (value >= 0) field << value;
   return field.str();
 }
+
+namespace {
+// A figure that may not have been recorded (negative) as JSON: null then.
+Json RecordedNumber(double value) { return value >= 0 ? Json(value) : Json(); }
 }  // namespace
 
 Json ToJson(const std::vector<RunResult>& results) {

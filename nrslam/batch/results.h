@@ -91,6 +91,8 @@ double MeanOfRecorded(const std::vector<double>& figures);
 // A figure in mm that may be missing, such as a trajectory error or a mean of the map-scale
 // RMSE, as a table shows it: "-" when there is none (negative).
 std::string MillimetresCell(double mm);
+// The same figure as a CSV field: empty when there is none (negative).
+std::string RecordedField(double value);
 
 // Reads each run's summary.json (or failure.json) from its folder.
 std::vector<RunResult> CollectResults(const EvaluationPlan& plan);

@@ -149,10 +149,8 @@ void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem
       csv << ',' << group.mean_rmse_mm << ',';
       if (group.scored > 1) csv << group.sd_rmse_mm;
       csv << ',' << group.median_rmse_mm << ','
-          << group.min_rmse_mm << ',' << group.max_rmse_mm << ',';
-      if (group.mean_map_scale_mm >= 0) csv << group.mean_map_scale_mm;
-      csv << ',';
-      if (group.mean_ate_mm >= 0) csv << group.mean_ate_mm;
+          << group.min_rmse_mm << ',' << group.max_rmse_mm << ',' << RecordedField(group.mean_map_scale_mm) << ','
+          << RecordedField(group.mean_ate_mm);
     } else {
       csv << ",,,,,,,";
     }

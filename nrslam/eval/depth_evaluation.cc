@@ -197,7 +197,8 @@ OtherAlignments EvaluateOtherAlignments(const std::vector<FrameEvaluation>& fram
     for (size_t i = 0; i < frame.estimated.size(); ++i) {
       if (frame.estimated[i] > 0) ratios.push_back(frame.groundtruth[i] / frame.estimated[i]);
     }
-    // With no estimate in front of the camera there is no ratio; scale 0 scores them all as missing.
+    // With no estimate in front of the camera there is no ratio; scale 0 scores every estimate
+    // as depth 0, so the frame gets the RMSE of its true depths.
     const double median_scale = ratios.empty() ? 0.0 : Median(ratios);
     at_map_scale.push_back(
         EvaluateDepthPairsAtScale(frame.estimated, frame.groundtruth, map_scale.at(frame.map), options).rmse_mm);
