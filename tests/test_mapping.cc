@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -20,6 +21,7 @@
 #include "nrslam/mapping/deformable_ba.h"
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/sim/simulate.h"
+#include "nrslam/util/median.h"
 #include "nrslam/util/random.h"
 
 namespace nrslam {
@@ -212,13 +214,14 @@ class MonocularInitialiserTest : public ::testing::Test {
 
   // Feeds frames until the initialiser succeeds; `spoil_mask` may change each frame's mask first.
   static InitialisationAttempt Initialise(int* frame, const std::function<void(int, cv::Mat&)>& spoil_mask = {},
-                                          double point_min_parallax_snr = 0) {
+                                          double point_min_parallax_snr = 0, double shading_weight = 0) {
     const SequenceReader reader(*folder_);
     // 320x240 has about a quarter of the corners of 640x480: the count thresholds scale down.
     InitialisationOptions options;
     options.min_tracks = 50;
     options.min_points = 50;
     options.point_min_parallax_snr = point_min_parallax_snr;
+    options.shading_weight = shading_weight;
     MonocularInitialiser initialiser(reader.info().camera, FrontendOptions{}, 600, options);
     for (*frame = 0; *frame < reader.frame_count(); ++*frame) {
       const cv::Mat bgr = reader.ReadRgb(*frame);
@@ -308,6 +311,46 @@ TEST_F(MonocularInitialiserTest, PairsStayAlignedWhenReferenceCornersAreLost) {
   // And the map still has structure: better than all points at one depth.
   const FrameEvaluation evaluation = Evaluate(map, frame);
   EXPECT_LT(evaluation.rmse_mm, evaluation.flat_rmse_mm);
+}
+
+// The shading prior moves each initial point along its own ray and nothing else: the same
+// points, pixels and frame, the median depth still the target. At weight 1 the map's shape is
+// the brightness's alone, at 0.5 halfway (in log distance) between that and the two views'.
+// On this still scene the two views are good, so the brightness map is the worse one, but it
+// still has the scene's structure.
+TEST_F(MonocularInitialiserTest, ShadingPriorMovesPointsAlongTheirRays) {
+  int frame = -1;
+  const InitialisationAttempt plain = Initialise(&frame);
+  ASSERT_TRUE(plain.success);
+  int shaded_frame = -1, half_frame = -1;
+  const InitialisationAttempt shaded = Initialise(&shaded_frame, {}, 0, 1.0);
+  const InitialisationAttempt half = Initialise(&half_frame, {}, 0, 0.5);
+  ASSERT_TRUE(shaded.success && half.success);
+  EXPECT_EQ(shaded_frame, frame);
+  EXPECT_EQ(half_frame, frame);
+  const auto& points = plain.map.seed.points;
+  ASSERT_EQ(shaded.map.seed.points.size(), points.size());
+  ASSERT_EQ(half.map.seed.points.size(), points.size());
+  std::vector<double> depths, log_offsets;
+  int moved = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    const Eigen::Vector3d& s = shaded.map.seed.points[i];
+    EXPECT_EQ(shaded.map.seed.pixels[i], plain.map.seed.pixels[i]);
+    EXPECT_LT(p.normalized().cross(s.normalized()).norm(), 1e-12);
+    depths.push_back(s.z());
+    // Halfway in log distance, up to the one factor each map is scaled by.
+    log_offsets.push_back(std::log(half.map.seed.points[i].norm()) - 0.5 * (std::log(p.norm()) + std::log(s.norm())));
+    moved += std::abs(std::log(s.norm() / p.norm())) > 0.05;
+  }
+  EXPECT_NEAR(Median(depths), 3.0, 1e-9);
+  for (double offset : log_offsets) EXPECT_NEAR(offset, log_offsets.front(), 1e-9);
+  EXPECT_GT(moved, static_cast<int>(points.size()) / 4);
+  const FrameEvaluation evaluation = Evaluate(shaded.map, frame);
+  std::cout << "shading prior, weight 1: depth RMSE " << evaluation.rmse_mm << " mm against "
+            << Evaluate(plain.map, frame).rmse_mm << " mm from two views (a flat map: " << evaluation.flat_rmse_mm
+            << " mm)\n";
+  EXPECT_LT(evaluation.rmse_mm, 0.8 * evaluation.flat_rmse_mm);
 }
 
 // The parallax gate relative to the epipolar error keeps a subset of the points the plain gate

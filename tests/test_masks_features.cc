@@ -3,6 +3,7 @@
 #include "frontend_fixtures.h"
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
+#include "nrslam/frontend/shading.h"
 #include "nrslam/util/error.h"
 
 namespace nrslam {
@@ -50,6 +51,69 @@ TEST(Features, RenderedMucosaGivesManyCornersThatRespectMaskSpacingAndExclusion)
   }
   options.max_features = 25;
   EXPECT_EQ(DetectCorners(grey, valid, {}, options).size(), 25u);
+}
+
+TEST(Shading, BrightnessIsTheLinearMeanOverTheValidPixelsOfTheBox) {
+  // Left half grey 200, right half grey 50; the right half is invalid except one column.
+  cv::Mat grey(40, 60, CV_8UC1, cv::Scalar(200));
+  grey(cv::Rect(30, 0, 30, 40)).setTo(50);
+  cv::Mat valid(grey.size(), CV_8UC1, cv::Scalar(255));
+  valid(cv::Rect(30, 0, 30, 40)).setTo(0);
+  valid(cv::Rect(45, 0, 1, 40)).setTo(255);
+  ShadingOptions options;
+  options.gamma = 2.0;
+  options.patch_px = 2;
+  const double bright = std::pow(200 / 255.0, 2.0), dark = std::pow(50 / 255.0, 2.0);
+  const std::vector<double> brightness = LinearBrightness(
+      grey, valid, {cv::Point2f(10, 10), cv::Point2f(31, 20), cv::Point2f(29, 20), cv::Point2f(38, 20),
+                    cv::Point2f(45.3f, 20), cv::Point2f(0, 0)},
+      options);
+  ASSERT_EQ(brightness.size(), 6u);
+  EXPECT_NEAR(brightness[0], bright, 1e-12);
+  EXPECT_NEAR(brightness[1], bright, 1e-12);                        // only its valid (left) columns count
+  EXPECT_NEAR(brightness[2], bright, 1e-12);                        // its two invalid dark columns do not count
+  EXPECT_EQ(brightness[3], 0.0);                                    // nothing valid in the box
+  EXPECT_NEAR(brightness[4], dark, 1e-12);                          // the one valid column
+  EXPECT_NEAR(brightness[5], bright, 1e-12);                        // a box cut by the image corner
+  // The mean is of linear levels, not of grey levels: a box half 200 and half 50 is brighter
+  // than grey 125 would be.
+  const double mixed = LinearBrightness(grey, cv::Mat(grey.size(), CV_8UC1, cv::Scalar(255)),
+                                        {cv::Point2f(29.5f, 20)}, ShadingOptions{})[0];
+  EXPECT_GT(mixed, std::pow(125 / 255.0, 2.2));
+}
+
+TEST(Shading, BlendMovesDistancesTowardWhatTheBrightnessSays) {
+  // Points lit from the camera: brightness 7 / r². The distances to correct are a compressed,
+  // rescaled version of the truth (what two views of moving tissue give): 3·r^0.6.
+  const std::vector<double> truth = {20, 25, 33, 41, 60, 95, 120};  // an odd count: one median
+  ShadedPoints measured;
+  for (double r : truth) {
+    measured.distances.push_back(3 * std::pow(r, 0.6));
+    measured.brightness.push_back(7 / (r * r));
+  }
+  // Weight 1: the truth up to one factor, whatever the calibration's own distances say.
+  const std::vector<double> shaded = BlendWithShading(measured, measured, 1.0);
+  for (size_t i = 1; i < truth.size(); ++i) EXPECT_NEAR(shaded[i] / truth[i], shaded[0] / truth[0], 1e-9);
+  // The factor puts the brightness on the calibration's scale: the median log ratio is 0.
+  std::vector<double> log_ratios;
+  for (size_t i = 0; i < truth.size(); ++i) log_ratios.push_back(std::log(shaded[i] / measured.distances[i]));
+  std::sort(log_ratios.begin(), log_ratios.end());
+  EXPECT_NEAR(log_ratios[truth.size() / 2], 0.0, 1e-9);
+  // Weight 0 changes nothing; 0.5 is the geometric mean of the two.
+  const std::vector<double> unchanged = BlendWithShading(measured, measured, 0.0);
+  const std::vector<double> half = BlendWithShading(measured, measured, 0.5);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_NEAR(unchanged[i], measured.distances[i], 1e-12);
+    EXPECT_NEAR(half[i], std::sqrt(shaded[i] * measured.distances[i]), 1e-9);
+  }
+  // Targets other than the calibration points; one without a brightness keeps its distance.
+  const ShadedPoints targets{{10, 10}, {7 / (50.0 * 50.0), 0}};
+  const std::vector<double> moved = BlendWithShading(measured, targets, 1.0);
+  EXPECT_NEAR(moved[0] / 50, shaded[0] / truth[0], 1e-9);
+  EXPECT_EQ(moved[1], 10);
+  // No calibration point with a brightness: nothing to scale by, nothing moves.
+  const ShadedPoints dark{{5, 6}, {0, 0}};
+  EXPECT_EQ(BlendWithShading(dark, targets, 1.0), targets.distances);
 }
 
 }  // namespace

@@ -15,6 +15,10 @@ void FeatureOptions::Check() const {
   CheckOption(max_features >= 1, "features", "max_features must be >= 1");
 }
 
+void ShadingOptions::Check() const {
+  CheckOption(gamma > 0 && patch_px >= 0, "shading", "need gamma > 0 and patch_px >= 0");
+}
+
 void KltOptions::Check() const {
   CheckOption(window_px >= 5 && window_px % 2 == 1 && window_px <= 63, "klt", "window_px must be odd, 5..63");
   CheckOption(levels >= 1 && levels <= 8, "klt", "levels must be 1..8");

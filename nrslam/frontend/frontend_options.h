@@ -48,14 +48,24 @@ struct KltOptions {
   void Check() const;
 };
 
+// How a pixel's brightness is read for the shading prior (frontend/shading.h); the prior
+// itself is off unless initialisation.shading_weight or mapping.new_point_shading_weight is set.
+struct ShadingOptions {
+  double gamma = 2.2;  // the camera's response: linear brightness = (grey level / 255)^gamma
+  int patch_px = 5;    // a pixel's brightness: the mean over the valid pixels of a (2·this + 1)² box
+  void Check() const;
+};
+
 struct FrontendOptions {
   MaskOptions masks;
   FeatureOptions features;
   KltOptions klt;
+  ShadingOptions shading;
   void Check() const {
     masks.Check();
     features.Check();
     klt.Check();
+    shading.Check();
   }
 };
 
@@ -65,6 +75,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureOptions, min_eigenvalue, 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(KltOptions, window_px, levels, max_iterations, epsilon_px,
                                                 min_eigenvalue, max_displacement_px, affine_refinement, affine_iterations, ssim_tracking,
                                                 ssim_initialisation, ssim_reassociation, min_texture_correlation)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FrontendOptions, masks, features, klt)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ShadingOptions, gamma, patch_px)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FrontendOptions, masks, features, klt, shading)
 
 }  // namespace nrslam

@@ -2,6 +2,7 @@
 
 #include <ceres/problem.h>
 #include <ceres/solver.h>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +10,8 @@
 
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
+#include "nrslam/frontend/masks.h"
+#include "nrslam/frontend/shading.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/stopwatch.h"
 
@@ -19,9 +22,9 @@ Eigen::Vector2d ToEigen(const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y)
 
 }  // namespace
 
-Mapper::Mapper(const Camera& camera, const DeformationModelOptions& deformation, const MappingOptions& options,
-               bool rigid)
-    : camera_(camera), deformation_(deformation), options_(options), rigid_(rigid) {
+Mapper::Mapper(const Camera& camera, const FrontendOptions& frontend, const DeformationModelOptions& deformation,
+               const MappingOptions& options, bool rigid)
+    : camera_(camera), frontend_(frontend), deformation_(deformation), options_(options), rigid_(rigid) {
   options_.Check();
 }
 
@@ -62,7 +65,7 @@ void Mapper::StartMap(const FrameResult& start, const Tracker& tracker, const st
   Record(start, tracker);
 }
 
-MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker) {
+MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask, Tracker* tracker) {
   MappingReport report;
   Record(result, *tracker);
   if (pending_dba_ && (result.frame >= pending_dba_->apply_frame || result.keyframe)) {
@@ -76,7 +79,7 @@ MappingReport Mapper::Process(const FrameResult& result, const cv::Mat& bgr, Tra
       StartDba(result.frame, tracker, &report);
     }
   } else {
-    Triangulate(result, bgr, tracker, &report);
+    Triangulate(result, bgr, mask, tracker, &report);
   }
   return report;
 }
@@ -121,16 +124,22 @@ double Mapper::BaselineRatio(const std::deque<Keyframe>& keyframes) const {
 void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
   const auto start = Clock::now();
   const Map& map = tracker->map();
-  const bool warmup = two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
-  const bool rigid_shape = rigid_ || warmup;
-  DbaRegularisers regularisers = rigid_shape ? DbaRegularisers{} : WindowRegularisers(map.graph(), Pointers(&keyframes_));
+  const bool warmup = !rigid_ && two_view_map_ && map_keyframes_ <= options_.rigid_warmup_keyframes;
+  WindowModel model = WindowModel::kSelected;
+  if (rigid_ || (warmup && options_.rigid_warmup_min_inliers == 0)) {
+    model = WindowModel::kRigid;
+  } else if (warmup) {
+    model = WindowModel::kRigidIfInliers;
+  }
+  DbaRegularisers regularisers =
+      model == WindowModel::kRigid ? DbaRegularisers{} : WindowRegularisers(map.graph(), Pointers(&keyframes_));
   PendingDba pending;
   pending.keyframe_frame = frame;
   pending.apply_frame = frame + options_.dba_lag_frames;
   pending.newest_before = keyframes_.back();
   // The job owns its copy of the window, which it adjusts and hands back.
   auto adjust = [this, keyframes = keyframes_, regularisers = std::move(regularisers), scale = map.scale(),
-                 rigid_shape]() mutable { return AdjustWindow(std::move(keyframes), regularisers, scale, rigid_shape); };
+                 model]() mutable { return AdjustWindow(std::move(keyframes), regularisers, scale, model); };
   // Deferred: run by FinishDba on this thread.
   pending.adjusted =
       std::async(options_.dba_lag_frames > 0 ? std::launch::async : std::launch::deferred, std::move(adjust));
@@ -140,25 +149,29 @@ void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
 }
 
 Mapper::AdjustedWindow Mapper::AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers,
-                                            double map_scale, bool rigid_shape) const {
+                                            double map_scale, WindowModel model) const {
   AdjustedWindow result;
+  bool rigid_shape = model == WindowModel::kRigid;
   bool adjusted = false;
   double baseline_ratio = -1, rigid_inlier_fraction = -1;  // not measured
-  if (!rigid_shape && options_.dba_model_selection) {
+  // A rigid adjustment of the window, kept when this fraction of it reprojects well.
+  const auto try_rigid = [&](double min_inliers) {
+    std::deque<Keyframe> trial = keyframes;
+    const DbaReport rigid_report = DeformableBundleAdjustment(camera_, deformation_, {}, map_scale,
+                                                              options_.dba_iterations, true, Pointers(&trial));
+    rigid_inlier_fraction = InlierFraction(trial);
+    if (rigid_inlier_fraction < min_inliers) return;
+    keyframes = std::move(trial);
+    result.report = rigid_report;
+    rigid_shape = adjusted = true;
+  };
+  if (model == WindowModel::kRigidIfInliers) {
+    try_rigid(options_.rigid_warmup_min_inliers);
+  } else if (model == WindowModel::kSelected && options_.dba_model_selection) {
     // The tracked camera travel, before any adjustment: a short baseline leaves a rigid fit
     // free to turn deformation into depth error, however well it reprojects.
     baseline_ratio = BaselineRatio(keyframes);
-    if (baseline_ratio >= options_.rigid_dba_min_baseline) {
-      std::deque<Keyframe> trial = keyframes;
-      const DbaReport rigid_report = DeformableBundleAdjustment(camera_, deformation_, {}, map_scale,
-                                                                options_.dba_iterations, true, Pointers(&trial));
-      rigid_inlier_fraction = InlierFraction(trial);
-      if (rigid_inlier_fraction >= options_.rigid_dba_min_inliers) {
-        keyframes = std::move(trial);
-        result.report = rigid_report;
-        rigid_shape = adjusted = true;
-      }
-    }
+    if (baseline_ratio >= options_.rigid_dba_min_baseline) try_rigid(options_.rigid_dba_min_inliers);
   }
   if (!adjusted) {
     result.report = DeformableBundleAdjustment(camera_, deformation_, regularisers, map_scale, options_.dba_iterations,
@@ -431,7 +444,8 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
   return points;
 }
 
-void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report) {
+void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask, Tracker* tracker,
+                         MappingReport* report) {
   const auto start = Clock::now();
   if (buffer_.size() < 2 || result.candidates.empty()) return;
   Map& map = tracker->mutable_map();
@@ -467,7 +481,11 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
     for (const CandidateObservation& candidate : result.candidates) pixels.emplace(candidate.track_id, candidate.pixel);
     std::vector<PointId> created, existing;
     for (const TrackedPoint& point : result.points) existing.push_back(point.id);
-    for (const auto& [track_id, position] : *chosen) {
+    std::vector<std::pair<int, Eigen::Vector3d>> accepted = *chosen;
+    if (chosen == &deformable && options_.new_point_shading_weight > 0) {
+      ApplyShadingPrior(result, bgr, mask, pixels, &accepted);
+    }
+    for (const auto& [track_id, position] : accepted) {
       const cv::Point2f& pixel = pixels.at(track_id);
       const cv::Point at(std::clamp(cvRound(pixel.x), 0, bgr.cols - 1), std::clamp(cvRound(pixel.y), 0, bgr.rows - 1));
       const PointId id = map.AddPoint(position, bgr.at<cv::Vec3b>(at), result.frame);
@@ -478,6 +496,37 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker*
     report->new_points = static_cast<int>(created.size());
   }
   report->ms_triangulation = MillisecondsSince(start);
+}
+
+void Mapper::ApplyShadingPrior(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask,
+                               const std::unordered_map<int, cv::Point2f>& pixels,
+                               std::vector<std::pair<int, Eigen::Vector3d>>* points) const {
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
+  // Calibration: the frame's tracked points (buffer_.back() is this frame), whose distances
+  // the map holds.
+  const Snapshot& now = buffer_.back();
+  std::vector<cv::Point2f> tracked_pixels;
+  ShadedPoints tracked;
+  for (const auto& [id, observation] : now.points) {
+    tracked_pixels.push_back(observation.first);
+    tracked.distances.push_back((now.cam_from_world * observation.second).norm());
+  }
+  tracked.brightness = LinearBrightness(grey, valid, tracked_pixels, frontend_.shading);
+  std::vector<cv::Point2f> new_pixels;
+  ShadedPoints created;
+  for (const auto& [track_id, position] : *points) {
+    new_pixels.push_back(pixels.at(track_id));
+    created.distances.push_back((now.cam_from_world * position).norm());
+  }
+  created.brightness = LinearBrightness(grey, valid, new_pixels, frontend_.shading);
+  const std::vector<double> blended = BlendWithShading(tracked, created, options_.new_point_shading_weight);
+  const Rigid3 world_from_cam = now.cam_from_world.Inverse();
+  for (size_t i = 0; i < points->size(); ++i) {
+    Eigen::Vector3d& position = (*points)[i].second;
+    position = world_from_cam * ((now.cam_from_world * position) * (blended[i] / created.distances[i]));
+  }
 }
 
 }  // namespace nrslam

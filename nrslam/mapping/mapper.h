@@ -21,6 +21,7 @@
 
 #include "nrslam/camera/camera.h"
 #include "nrslam/deformation/deformation_options.h"
+#include "nrslam/frontend/frontend_options.h"
 #include "nrslam/geometry/two_view.h"
 #include "nrslam/mapping/deformable_ba.h"
 #include "nrslam/mapping/mapping_options.h"
@@ -38,13 +39,16 @@ struct MappingReport {
 
 class Mapper {
  public:
-  Mapper(const Camera& camera, const DeformationModelOptions& deformation, const MappingOptions& options, bool rigid);
+  // `frontend`: the validity masks and brightness reading of the shading prior.
+  Mapper(const Camera& camera, const FrontendOptions& frontend, const DeformationModelOptions& deformation,
+         const MappingOptions& options, bool rigid);
 
   // A new map was started on `start` (the tracker's first frame); `reference`, when given, is
   // the initialisation's other view (its pixels aligned with the map's first points).
   void StartMap(const FrameResult& start, const Tracker& tracker, const std::optional<Keyframe>& reference);
-  // After a tracked frame; may change the tracker's map and pose.
-  MappingReport Process(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker);
+  // After a tracked frame; may change the tracker's map and pose. `mask`: the sequence's mask
+  // of the frame (may be empty).
+  MappingReport Process(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask, Tracker* tracker);
 
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
   // The points the DBA window observes (a DBA in flight adjusts the same window).
@@ -65,6 +69,7 @@ class Mapper {
   };
 
   Camera camera_;
+  FrontendOptions frontend_;
   DeformationModelOptions deformation_;
   MappingOptions options_;
   bool rigid_;
@@ -97,13 +102,22 @@ class Mapper {
   void FinishDba(int frame, Tracker* tracker, MappingReport* report);
   // The DBA proper (rigid trial, model selection, deformable adjustment); reads only its
   // arguments and constant members, so it can run beside tracking.
+  // How a window is adjusted: rigidly (a rigid map, or the warm-up), rigidly if that fits
+  // well enough (a gated warm-up: mapping.rigid_warmup_min_inliers), or by model selection.
+  enum class WindowModel { kRigid, kRigidIfInliers, kSelected };
   AdjustedWindow AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers, double map_scale,
-                              bool rigid_shape) const;
+                              WindowModel model) const;
   // Of every (keyframe, point) observation, the fraction reprojecting within max_reprojection_px2.
   double InlierFraction(const std::deque<Keyframe>& keyframes) const;
   // Camera travel from the oldest to the newest keyframe over the newest one's median depth.
   double BaselineRatio(const std::deque<Keyframe>& keyframes) const;
-  void Triangulate(const FrameResult& result, const cv::Mat& bgr, Tracker* tracker, MappingReport* report);
+  void Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask, Tracker* tracker,
+                   MappingReport* report);
+  // The shading prior on new points (mapping.new_point_shading_weight): `points` (track id,
+  // world position) moved along their rays in this frame.
+  void ApplyShadingPrior(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask,
+                         const std::unordered_map<int, cv::Point2f>& pixels,
+                         std::vector<std::pair<int, Eigen::Vector3d>>* points) const;
   // One candidate's rigid and deformable points (either may be missing); reads only the
   // buffer and the options, so candidates can be triangulated side by side.
   struct CandidatePoints {

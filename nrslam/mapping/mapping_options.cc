@@ -13,6 +13,7 @@ void InitialisationOptions::Check() const {
   CheckOption(max_low_parallax_fraction >= 0 && max_low_parallax_fraction <= 1, "initialisation",
               "max_low_parallax_fraction must be in [0, 1]");
   CheckOption(point_min_parallax_snr >= 0, "initialisation", "point_min_parallax_snr must be >= 0");
+  CheckOption(shading_weight >= 0 && shading_weight <= 1, "initialisation", "shading_weight must be in [0, 1]");
   CheckOption(initial_graph == "complete" || initial_graph == "flow_clusters", "initialisation",
               "initial_graph must be complete or flow_clusters, got '" + initial_graph + "'");
   CheckOption(dbscan_epsilon_px > 0 && dbscan_min_points >= 1, "initialisation", "DBSCAN parameters must be positive");
@@ -32,6 +33,10 @@ void MappingOptions::Check() const {
                   reprojection_outlier_chi2 > 0 && deformable_min_parallax_px >= 0,
               "mapping", "thresholds must be positive");
   CheckOption(rigid_warmup_keyframes >= 0, "mapping", "rigid_warmup_keyframes must be >= 0");
+  CheckOption(rigid_warmup_min_inliers >= 0 && rigid_warmup_min_inliers <= 1, "mapping",
+              "rigid_warmup_min_inliers must be in [0, 1]");
+  CheckOption(new_point_shading_weight >= 0 && new_point_shading_weight <= 1, "mapping",
+              "new_point_shading_weight must be in [0, 1]");
   CheckOption(rigid_dba_min_inliers >= 0 && rigid_dba_min_inliers <= 1 && rigid_dba_min_baseline >= 0, "mapping",
               "need rigid_dba_min_inliers in [0, 1] and rigid_dba_min_baseline >= 0");
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");

@@ -27,6 +27,15 @@ struct InitialisationOptions {
   // that error says how much of a small parallax is deformation. 0 = off (the reference).
   double point_min_parallax_snr = 0;
   double median_depth = 3.0;         // the map is scaled to this median depth, map units
+  // Shading prior (frontend/shading.h; not in the paper or the reference): each initial point
+  // is moved along its reference ray to log r = w·log r_shading + (1 − w)·log r_two_view, the
+  // brightness read in the reference image. Two views a few frames apart of tissue that moves
+  // as far as the camera give poor depths; the brightness does not depend on the motion. It
+  // suits a tube lit from the tip and hurts where incidence and albedo vary more than distance
+  // (lap-lobes) or where two views are already good (a still scene); use it with
+  // mapping.rigid_warmup_min_inliers, else the rigid warm-up undoes it (README, "Mapping").
+  // 0 = off (the paper).
+  double shading_weight = 0;
   // Initial DDG: "complete" joins every pair of initial points (the reference); "flow_clusters"
   // joins only points whose optical flow since the reference falls in the same DBSCAN cluster.
   std::string initial_graph = "complete";
@@ -36,7 +45,8 @@ struct InitialisationOptions {
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InitialisationOptions, min_tracks, max_reference_age, ransac_iterations,
                                                 epipolar_threshold_px, min_parallax_px, max_reprojection_px2, min_points,
-                                                max_low_parallax_fraction, point_min_parallax_snr, median_depth, initial_graph,
+                                                max_low_parallax_fraction, point_min_parallax_snr, median_depth,
+                                                shading_weight, initial_graph,
                                                 dbscan_epsilon_px, dbscan_min_points)
 
 struct MappingOptions {
@@ -58,6 +68,13 @@ struct MappingOptions {
   // is left alone (warming it up made depth-initialised runs worse). 0 = off (the
   // reference); 4 measured best of 0, 4, 6, 8, 12 on the suite (README, "Mapping").
   int rigid_warmup_keyframes = 4;
+  // The warm-up's rigid result is kept only when at least this fraction of the window's
+  // observations reprojects within max_reprojection_px2; otherwise the window gets the
+  // deformable DBA. With the shading prior (initialisation.shading_weight) the two-view depths
+  // are no longer the map's, and an unconditional warm-up would bring them back; 0.99 keeps it
+  // in still scenes (fractions ≥ 0.999 measured) and not in deforming ones (0.96 and below).
+  // 0 = always kept (as without the prior).
+  double rigid_warmup_min_inliers = 0;
   // Model selection for the DBA (not in the reference; the paper selects models only for new
   // points): after the warm-up, a window is first adjusted rigidly, and that result is kept
   // (and becomes the DDG's rest shape) when the camera travelled far enough over the window
@@ -128,17 +145,23 @@ struct MappingOptions {
   double flow_outlier_chi2 = 7.815;  // reject if more than half the flow residuals exceed it ...
   double reprojection_outlier_chi2 = 59.9;  // ... or more than half the reprojections exceed this
   double model_selection_factor = 1.5;  // keep a model's points only if it found this many times more
+  // Shading prior for new points (frontend/shading.h; not in the paper or the reference): the
+  // points of deformable triangulation, whose depth along a short-baseline ray is weak, are moved
+  // along their ray to log r = w·log r_shading + (1 − w)·log r, the brightness calibrated on the
+  // frame's tracked points. Rigid triangulation passed its rigidity and parallax gates and is
+  // left alone. 0 = off (the paper).
+  double new_point_shading_weight = 0;
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
                                                 dba_lag_frames,
-                                                rigid_warmup_keyframes, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
+                                                rigid_warmup_keyframes, rigid_warmup_min_inliers, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_triangulation, deformable_gate_span,
                                                 shortest_gate_below_fraction, starving_two_ray_check, deformable_min_track,
                                                 deformable_agreement_ratio, deformable_max_epipolar_ratio, starving_max_epipolar_ratio, deformable_min_parallax_px,
                                                 flow_sigma, deformable_iterations, flow_outlier_chi2,
-                                                reprojection_outlier_chi2, model_selection_factor)
+                                                reprojection_outlier_chi2, model_selection_factor, new_point_shading_weight)
 
 }  // namespace nrslam

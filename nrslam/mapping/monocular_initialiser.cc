@@ -9,6 +9,7 @@
 
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
+#include "nrslam/frontend/shading.h"
 #include "nrslam/geometry/two_view.h"
 #include "nrslam/util/median.h"
 
@@ -71,6 +72,10 @@ InitialisationAttempt MonocularInitialiser::StartReference(int frame, const cv::
   features.max_features = max_points_;
   reference_pixels_ = DetectCorners(grey, valid, {}, features);
   klt_.SetReference(ImagePyramid(grey, frontend_.klt.levels), reference_pixels_, valid);
+  reference_brightness_.clear();
+  if (options_.shading_weight > 0) {
+    reference_brightness_ = LinearBrightness(grey, valid, reference_pixels_, frontend_.shading);
+  }
   reference_frame_ = frame;
   history_.assign(reference_pixels_.size(), {});
   alive_.assign(reference_pixels_.size(), false);
@@ -197,6 +202,8 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
     }
   }
 
+  if (options_.shading_weight > 0) ApplyShadingPrior(kept, &points);
+
   // Scale: median reference-camera depth → options_.median_depth.
   std::vector<double> depths;
   for (const auto& p : points) depths.push_back(p.z());
@@ -222,6 +229,19 @@ InitialisationAttempt MonocularInitialiser::Reconstruct(const std::vector<int>& 
   attempt.note = std::to_string(essential->inlier_count) + " E inliers, " + std::to_string(seed.points.size()) +
                  " points, " + std::to_string(static_cast<int>(100 * low_fraction)) + " % low parallax";
   return attempt;
+}
+
+void MonocularInitialiser::ApplyShadingPrior(const std::vector<int>& tracks,
+                                             std::vector<Eigen::Vector3d>* points) const {
+  // The two-view map calibrates the brightness of its own points: the blend changes the
+  // shape of the map, not its scale.
+  ShadedPoints shaded;
+  for (size_t i = 0; i < points->size(); ++i) {
+    shaded.distances.push_back((*points)[i].norm());
+    shaded.brightness.push_back(reference_brightness_[tracks[i]]);
+  }
+  const std::vector<double> blended = BlendWithShading(shaded, shaded, options_.shading_weight);
+  for (size_t i = 0; i < points->size(); ++i) (*points)[i] *= blended[i] / shaded.distances[i];
 }
 
 std::vector<int> MonocularInitialiser::FlowClusters(const std::vector<int>& tracks) const {

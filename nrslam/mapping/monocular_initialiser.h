@@ -8,6 +8,8 @@
 // inverse-depth weighted mid-point; the map is accepted once enough points pass the
 // parallax, depth and reprojection gates and few inliers still lack parallax. The map is then
 // scaled to the target median depth. The reference restarts when its tracks run out or it ages.
+// With initialisation.shading_weight > 0 the points' distances are blended with what the
+// reference image's brightness says (frontend/shading.h) before the map is scaled.
 #pragma once
 
 #include <Eigen/Core>
@@ -62,12 +64,15 @@ class MonocularInitialiser {
   KltTracker klt_;
   int reference_frame_ = -1;
   std::vector<cv::Point2f> reference_pixels_;
+  std::vector<double> reference_brightness_;  // per reference corner; read only for the shading prior
   std::vector<std::vector<cv::Point2f>> history_;  // per reference corner, its pixel in every frame since
   std::vector<bool> alive_;
 
   InitialisationAttempt StartReference(int frame, const cv::Mat& grey, const cv::Mat& mask, const std::string& why);
   InitialisationAttempt Reconstruct(const std::vector<int>& tracks) const;
   std::vector<int> FlowClusters(const std::vector<int>& tracks) const;
+  // Moves each point (reference camera frame) along its ray to the blended distance.
+  void ApplyShadingPrior(const std::vector<int>& tracks, std::vector<Eigen::Vector3d>* points) const;
 };
 
 // DBSCAN over the rows of `points` (Euclidean): a label per row, −1 for noise.

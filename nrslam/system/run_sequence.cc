@@ -118,7 +118,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
 
   Tracker tracker(camera, options.frontend, options.deformation, options.tracking);
   tracker.EnableCandidates(options.run.mapping);
-  Mapper mapper(camera, options.deformation, options.mapping, options.tracking.rigid);
+  Mapper mapper(camera, options.frontend, options.deformation, options.mapping, options.tracking.rigid);
   MonocularInitialiser initialiser(camera, options.frontend, options.tracking.max_points, options.initialisation);
   const bool monocular = options.run.init == "monocular";
   int maps = 0;  // maps started so far: a monocular run starts a new one after each loss
@@ -156,14 +156,19 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         if (result.state == TrackingState::kLost) {
           log << "frame " << frame << ": lost (" << result.note << ")\n";
         } else if (options.run.mapping) {
-          mapping = mapper.Process(result, bgr, &tracker);
+          mapping = mapper.Process(result, bgr, mask, &tracker);
           result.cam_from_world = tracker.pose();  // the DBA may have refined it
           if (mapping.new_points > 0) log << "frame " << frame << ": " << mapping.new_points << " new points\n";
-          if (mapping.dba && mapping.dba_report.baseline_ratio >= 0) {
+          // Windows whose model was chosen: by model selection, or a gated warm-up (no baseline test).
+          const DbaReport& dba = mapping.dba_report;
+          if (mapping.dba && (dba.baseline_ratio >= 0 || dba.rigid_inlier_fraction >= 0)) {
             std::ostringstream line;  // its precision stays with this line, not the whole log
-            line << "frame " << frame << ": DBA " << (mapping.dba_report.rigid ? "rigid" : "deformable")
-                 << std::setprecision(3) << " (baseline ratio " << mapping.dba_report.baseline_ratio
-                 << ", rigid inliers " << mapping.dba_report.rigid_inlier_fraction << ")\n";
+            line << "frame " << frame << ": DBA " << (dba.rigid ? "rigid" : "deformable") << std::setprecision(3);
+            if (dba.baseline_ratio >= 0) {
+              line << " (baseline ratio " << dba.baseline_ratio << ", rigid inliers " << dba.rigid_inlier_fraction << ")\n";
+            } else {
+              line << " (warm-up, rigid inliers " << dba.rigid_inlier_fraction << ")\n";
+            }
             log << line.str();
           }
         }
