@@ -483,7 +483,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
     for (const TrackedPoint& point : result.points) existing.push_back(point.id);
     std::vector<std::pair<int, Eigen::Vector3d>> accepted = *chosen;
     if (chosen == &deformable && options_.new_point_shading_weight > 0) {
-      ApplyShadingPrior(result, bgr, mask, pixels, &accepted);
+      ApplyShadingPrior(bgr, mask, pixels, &accepted);
     }
     for (const auto& [track_id, position] : accepted) {
       const cv::Point2f& pixel = pixels.at(track_id);
@@ -498,7 +498,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
   report->ms_triangulation = MillisecondsSince(start);
 }
 
-void Mapper::ApplyShadingPrior(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask,
+void Mapper::ApplyShadingPrior(const cv::Mat& bgr, const cv::Mat& mask,
                                const std::unordered_map<int, cv::Point2f>& pixels,
                                std::vector<std::pair<int, Eigen::Vector3d>>* points) const {
   cv::Mat grey;

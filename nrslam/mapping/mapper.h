@@ -114,8 +114,8 @@ class Mapper {
   void Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask, Tracker* tracker,
                    MappingReport* report);
   // The shading prior on new points (mapping.new_point_shading_weight): `points` (track id,
-  // world position) moved along their rays in this frame.
-  void ApplyShadingPrior(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask,
+  // world position) moved along their rays in this frame (the newest snapshot).
+  void ApplyShadingPrior(const cv::Mat& bgr, const cv::Mat& mask,
                          const std::unordered_map<int, cv::Point2f>& pixels,
                          std::vector<std::pair<int, Eigen::Vector3d>>* points) const;
   // One candidate's rigid and deformable points (either may be missing); reads only the
