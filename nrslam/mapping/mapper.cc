@@ -470,7 +470,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
   report->rigid_candidates = static_cast<int>(rigid.size());
   report->deformable_candidates = static_cast<int>(deformable.size());
   const double factor = options_.model_selection_factor;
-  const std::vector<std::pair<int, Eigen::Vector3d>>* chosen = nullptr;
+  std::vector<std::pair<int, Eigen::Vector3d>>* chosen = nullptr;
   if (rigid.size() > factor * deformable.size()) {
     chosen = &rigid;
   } else if (deformable.size() >= factor * rigid.size()) {
@@ -481,11 +481,10 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
     for (const CandidateObservation& candidate : result.candidates) pixels.emplace(candidate.track_id, candidate.pixel);
     std::vector<PointId> created, existing;
     for (const TrackedPoint& point : result.points) existing.push_back(point.id);
-    std::vector<std::pair<int, Eigen::Vector3d>> accepted = *chosen;
     if (chosen == &deformable && options_.new_point_shading_weight > 0) {
-      ApplyShadingPrior(bgr, mask, pixels, &accepted);
+      ApplyShadingPrior(bgr, mask, pixels, &deformable);
     }
-    for (const auto& [track_id, position] : accepted) {
+    for (const auto& [track_id, position] : *chosen) {
       const cv::Point2f& pixel = pixels.at(track_id);
       const cv::Point at(std::clamp(cvRound(pixel.x), 0, bgr.cols - 1), std::clamp(cvRound(pixel.y), 0, bgr.rows - 1));
       const PointId id = map.AddPoint(position, bgr.at<cv::Vec3b>(at), result.frame);
@@ -515,17 +514,18 @@ void Mapper::ApplyShadingPrior(const cv::Mat& bgr, const cv::Mat& mask,
   }
   tracked.brightness = LinearBrightness(grey, valid, tracked_pixels, frontend_.shading);
   std::vector<cv::Point2f> new_pixels;
+  std::vector<Eigen::Vector3d> in_camera;
   ShadedPoints created;
   for (const auto& [track_id, position] : *points) {
     new_pixels.push_back(pixels.at(track_id));
-    created.distances.push_back((now.cam_from_world * position).norm());
+    in_camera.push_back(now.cam_from_world * position);
+    created.distances.push_back(in_camera.back().norm());
   }
   created.brightness = LinearBrightness(grey, valid, new_pixels, frontend_.shading);
   const std::vector<double> blended = BlendWithShading(tracked, created, options_.new_point_shading_weight);
   const Rigid3 world_from_cam = now.cam_from_world.Inverse();
   for (size_t i = 0; i < points->size(); ++i) {
-    Eigen::Vector3d& position = (*points)[i].second;
-    position = world_from_cam * ((now.cam_from_world * position) * (blended[i] / created.distances[i]));
+    (*points)[i].second = world_from_cam * (in_camera[i] * (blended[i] / created.distances[i]));
   }
 }
 

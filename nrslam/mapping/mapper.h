@@ -100,11 +100,11 @@ class Mapper {
   // Waits for the pending DBA and applies it: keyframe poses and shapes, the map, the buffer
   // and the tracker's pose.
   void FinishDba(int frame, Tracker* tracker, MappingReport* report);
-  // The DBA proper (rigid trial, model selection, deformable adjustment); reads only its
-  // arguments and constant members, so it can run beside tracking.
   // How a window is adjusted: rigidly (a rigid map, or the warm-up), rigidly if that fits
   // well enough (a gated warm-up: mapping.rigid_warmup_min_inliers), or by model selection.
   enum class WindowModel { kRigid, kRigidIfInliers, kSelected };
+  // The DBA proper (rigid trial, model selection, deformable adjustment); reads only its
+  // arguments and constant members, so it can run beside tracking.
   AdjustedWindow AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers, double map_scale,
                               WindowModel model) const;
   // Of every (keyframe, point) observation, the fraction reprojecting within max_reprojection_px2.

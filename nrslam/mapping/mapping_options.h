@@ -72,7 +72,7 @@ struct MappingOptions {
   // observations reprojects within max_reprojection_px2; otherwise the window gets the
   // deformable DBA. With the shading prior (initialisation.shading_weight) the two-view depths
   // are no longer the map's, and an unconditional warm-up would bring them back; 0.99 keeps it
-  // in still scenes (fractions ≥ 0.999 measured) and not in deforming ones (0.96 and below).
+  // in still scenes (fractions ≥ 0.999 measured) and not in deforming ones (0.30–0.986).
   // 0 = always kept (as without the prior).
   double rigid_warmup_min_inliers = 0;
   // Model selection for the DBA (not in the reference; the paper selects models only for new
