@@ -43,6 +43,7 @@ struct DbaReport {
   // (negative when not measured; mapping.dba_model_selection).
   bool rigid = false;
   double baseline_ratio = -1, rigid_inlier_fraction = -1;
+  double tracked_deformation = -1;  // median per-frame median ‖δ‖ / map scale over the window
 };
 
 // A regularised pair of one window keyframe: a point and one of its best D graph

@@ -121,6 +121,14 @@ double Mapper::BaselineRatio(const std::deque<Keyframe>& keyframes) const {
   return travel / Median(depths);
 }
 
+double Mapper::TrackedDeformation(int since_frame, double map_scale) const {
+  std::vector<double> deformations;
+  for (const Snapshot& snapshot : buffer_) {
+    if (snapshot.frame >= since_frame) deformations.push_back(snapshot.median_displacement / map_scale);
+  }
+  return deformations.empty() ? -1 : Median(deformations);
+}
+
 void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
   const auto start = Clock::now();
   const Map& map = tracker->map();
@@ -138,8 +146,10 @@ void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
   pending.apply_frame = frame + options_.dba_lag_frames;
   pending.newest_before = keyframes_.back();
   // The job owns its copy of the window, which it adjusts and hands back.
-  auto adjust = [this, keyframes = keyframes_, regularisers = std::move(regularisers), scale = map.scale(),
-                 model]() mutable { return AdjustWindow(std::move(keyframes), regularisers, scale, model); };
+  auto adjust = [this, keyframes = keyframes_, regularisers = std::move(regularisers), scale = map.scale(), model,
+                 deformation = two_view_map_ ? -1.0 : TrackedDeformation(keyframes_.front().frame, map.scale())]() mutable {
+    return AdjustWindow(std::move(keyframes), regularisers, scale, model, deformation);
+  };
   // Deferred: run by FinishDba on this thread.
   pending.adjusted =
       std::async(options_.dba_lag_frames > 0 ? std::launch::async : std::launch::deferred, std::move(adjust));
@@ -149,7 +159,7 @@ void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
 }
 
 Mapper::AdjustedWindow Mapper::AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers,
-                                            double map_scale, WindowModel model) const {
+                                            double map_scale, WindowModel model, double tracked_deformation) const {
   AdjustedWindow result;
   bool rigid_shape = model == WindowModel::kRigid;
   bool adjusted = false;
@@ -171,7 +181,9 @@ Mapper::AdjustedWindow Mapper::AdjustWindow(std::deque<Keyframe> keyframes, cons
     // The tracked camera travel, before any adjustment: a short baseline leaves a rigid fit
     // free to turn deformation into depth error, however well it reprojects.
     baseline_ratio = BaselineRatio(keyframes);
-    if (baseline_ratio >= options_.rigid_dba_min_baseline) try_rigid(options_.rigid_dba_min_inliers);
+    const bool still = options_.rigid_dba_max_deformation == 0 || tracked_deformation < 0 ||
+                       tracked_deformation <= options_.rigid_dba_max_deformation;
+    if (baseline_ratio >= options_.rigid_dba_min_baseline && still) try_rigid(options_.rigid_dba_min_inliers);
   }
   if (!adjusted) {
     result.report = DeformableBundleAdjustment(camera_, deformation_, regularisers, map_scale, options_.dba_iterations,
@@ -180,6 +192,7 @@ Mapper::AdjustedWindow Mapper::AdjustWindow(std::deque<Keyframe> keyframes, cons
   result.report.rigid = rigid_shape;
   result.report.baseline_ratio = baseline_ratio;
   result.report.rigid_inlier_fraction = rigid_inlier_fraction;
+  result.report.tracked_deformation = tracked_deformation;
   result.keyframes = std::move(keyframes);
   return result;
 }

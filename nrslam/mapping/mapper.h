@@ -105,12 +105,16 @@ class Mapper {
   enum class WindowModel { kRigid, kRigidIfInliers, kSelected };
   // The DBA proper (rigid trial, model selection, deformable adjustment); reads only its
   // arguments and constant members, so it can run beside tracking.
+  // `tracked_deformation`: TrackedDeformation of the window, or -1 for no such test.
   AdjustedWindow AdjustWindow(std::deque<Keyframe> keyframes, const DbaRegularisers& regularisers, double map_scale,
-                              WindowModel model) const;
+                              WindowModel model, double tracked_deformation) const;
   // Of every (keyframe, point) observation, the fraction reprojecting within max_reprojection_px2.
   double InlierFraction(const std::deque<Keyframe>& keyframes) const;
   // Camera travel from the oldest to the newest keyframe over the newest one's median depth.
   double BaselineRatio(const std::deque<Keyframe>& keyframes) const;
+  // How much tracking deformed the map since `since_frame`: the median over the buffered
+  // frames from then on of each frame's median ‖δ‖, over `map_scale`; -1 with no such frame.
+  double TrackedDeformation(int since_frame, double map_scale) const;
   void Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv::Mat& mask, Tracker* tracker,
                    MappingReport* report);
   // The shading prior on new points (mapping.new_point_shading_weight): `points` (track id,

@@ -37,8 +37,9 @@ void MappingOptions::Check() const {
               "rigid_warmup_min_inliers must be in [0, 1]");
   CheckOption(new_point_shading_weight >= 0 && new_point_shading_weight <= 1, "mapping",
               "new_point_shading_weight must be in [0, 1]");
-  CheckOption(rigid_dba_min_inliers >= 0 && rigid_dba_min_inliers <= 1 && rigid_dba_min_baseline >= 0, "mapping",
-              "need rigid_dba_min_inliers in [0, 1] and rigid_dba_min_baseline >= 0");
+  CheckOption(rigid_dba_min_inliers >= 0 && rigid_dba_min_inliers <= 1 && rigid_dba_min_baseline >= 0 &&
+                  rigid_dba_max_deformation >= 0,
+              "mapping", "need rigid_dba_min_inliers in [0, 1], rigid_dba_min_baseline >= 0 and rigid_dba_max_deformation >= 0");
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
   CheckOption(deformable_agreement_ratio == 0 || deformable_agreement_ratio >= 1, "mapping",
               "deformable_agreement_ratio must be 0 (off) or >= 1");

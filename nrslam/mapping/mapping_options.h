@@ -84,6 +84,16 @@ struct MappingOptions {
   bool dba_model_selection = true;
   double rigid_dba_min_inliers = 0.95;  // fraction of the window's observations
   double rigid_dba_min_baseline = 0.2;  // camera travel over the window / median depth
+  // ... and, on a map from depth, when tracking saw the window's frames as still: the median
+  // over the buffered frames since the window's oldest keyframe of each frame's median ‖δ‖,
+  // at most this × map scale (rigidity_threshold's units). The inlier test is in pixels, so a
+  // deformation of a given size passes it the more easily the coarser the image; δ is
+  // measured in 3D. At 320×240 without it, rigid windows took deforming sim-1 and sim-3 maps
+  // from 0.9 / 1.6 to 4.9 / 5.6 mm. Not for two-view maps: there δ also carry corrections of
+  // the map's depths (a still scene's reached 0.0030, against at most 0.0015 from depth), and
+  // over 42 monocular renderings the test was better on 3 and worse on 5 (README, "Mapping").
+  // 0 = no such test.
+  double rigid_dba_max_deformation = 0.004;
   // New points from 2D tracks (corners detected at keyframes) over the last frames.
   int temporal_window = 20;          // frames of track history kept
   double crowding_radius_px = 20;    // no new point this close to a tracked 3D point
@@ -156,6 +166,7 @@ struct MappingOptions {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window, dba_min_keyframes, dba_iterations,
                                                 dba_lag_frames,
                                                 rigid_warmup_keyframes, rigid_warmup_min_inliers, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
+                                                rigid_dba_max_deformation,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
                                                 max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_triangulation, deformable_gate_span,

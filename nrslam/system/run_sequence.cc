@@ -165,7 +165,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
             std::ostringstream line;  // its precision stays with this line, not the whole log
             line << "frame " << frame << ": DBA " << (dba.rigid ? "rigid" : "deformable") << std::setprecision(3);
             if (dba.baseline_ratio >= 0) {
-              line << " (baseline ratio " << dba.baseline_ratio << ", rigid inliers " << dba.rigid_inlier_fraction << ")\n";
+              line << " (baseline ratio " << dba.baseline_ratio << ", rigid inliers " << dba.rigid_inlier_fraction;
+              if (dba.tracked_deformation >= 0) line << ", tracked deformation " << dba.tracked_deformation;
+              line << ")\n";
             } else {
               line << " (warm-up, rigid inliers " << dba.rigid_inlier_fraction << ")\n";
             }
