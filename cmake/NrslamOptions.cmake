@@ -9,3 +9,17 @@ add_library(nrslam_warnings INTERFACE)
 target_compile_options(nrslam_warnings INTERFACE
   -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align -Woverloaded-virtual
   -Wno-unused-parameter)
+
+# Developers' check for memory errors and undefined behaviour, e.g.
+#   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNRSLAM_SANITIZE=address,undefined
+# Every target of this project is instrumented (the Debian libraries are not); a finding
+# aborts the program, so CTest reports it as a failed test.
+set(NRSLAM_SANITIZE "" CACHE STRING "sanitizers to build with (-fsanitize=...), e.g. address,undefined; empty: none")
+if(NRSLAM_SANITIZE)
+  add_compile_options(-fsanitize=${NRSLAM_SANITIZE} -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=${NRSLAM_SANITIZE})
+  # Under AddressSanitizer Eigen stops trusting glibc's malloc to align and pads its blocks by
+  # hand, but Debian's Ceres (built without it) does not: a matrix Ceres allocates and our
+  # code frees (ceres::GradientChecker's results) would be freed at the wrong address.
+  add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
+endif()
