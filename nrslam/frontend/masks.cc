@@ -6,6 +6,12 @@
 
 namespace nrslam {
 
+cv::Mat ToGrey(const cv::Mat& bgr) {
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
 cv::Mat BuildValidityMask(const cv::Mat& grey, const cv::Mat& sequence_mask, const MaskOptions& options) {
   if (grey.type() != CV_8UC1) throw Error("BuildValidityMask: expected an 8-bit grey image");
   if (!sequence_mask.empty() && sequence_mask.size() != grey.size()) {

@@ -1,6 +1,7 @@
 #include "nrslam/frontend/shading.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "nrslam/util/median.h"
@@ -11,6 +12,9 @@ std::vector<double> LinearBrightness(const cv::Mat& grey, const cv::Mat& valid, 
                                      const ShadingOptions& options) {
   std::vector<double> brightness;
   brightness.reserve(pixels.size());
+  // One power per grey level rather than per pixel of every box (the same values).
+  std::array<double, 256> linear;
+  for (int level = 0; level < 256; ++level) linear[level] = std::pow(level / 255.0, options.gamma);
   const int half = options.patch_px;
   for (const cv::Point2f& pixel : pixels) {
     const int x = cvRound(pixel.x), y = cvRound(pixel.y);
@@ -19,7 +23,7 @@ std::vector<double> LinearBrightness(const cv::Mat& grey, const cv::Mat& valid, 
     for (int v = std::max(0, y - half); v <= std::min(grey.rows - 1, y + half); ++v) {
       for (int u = std::max(0, x - half); u <= std::min(grey.cols - 1, x + half); ++u) {
         if (valid.at<uint8_t>(v, u) == 0) continue;
-        sum += std::pow(grey.at<uint8_t>(v, u) / 255.0, options.gamma);
+        sum += linear[grey.at<uint8_t>(v, u)];
         ++count;
       }
     }

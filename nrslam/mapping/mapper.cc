@@ -2,7 +2,6 @@
 
 #include <ceres/problem.h>
 #include <ceres/solver.h>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -147,7 +146,9 @@ void Mapper::StartDba(int frame, Tracker* tracker, MappingReport* report) {
   pending.newest_before = keyframes_.back();
   // The job owns its copy of the window, which it adjusts and hands back.
   auto adjust = [this, keyframes = keyframes_, regularisers = std::move(regularisers), scale = map.scale(), model,
-                 deformation = two_view_map_ ? -1.0 : TrackedDeformation(keyframes_.front().frame, map.scale())]() mutable {
+                 deformation = two_view_map_ || options_.rigid_dba_max_deformation == 0
+                                   ? -1.0
+                                   : TrackedDeformation(keyframes_.front().frame, map.scale())]() mutable {
     return AdjustWindow(std::move(keyframes), regularisers, scale, model, deformation);
   };
   // Deferred: run by FinishDba on this thread.
@@ -181,8 +182,7 @@ Mapper::AdjustedWindow Mapper::AdjustWindow(std::deque<Keyframe> keyframes, cons
     // The tracked camera travel, before any adjustment: a short baseline leaves a rigid fit
     // free to turn deformation into depth error, however well it reprojects.
     baseline_ratio = BaselineRatio(keyframes);
-    const bool still = options_.rigid_dba_max_deformation == 0 || tracked_deformation < 0 ||
-                       tracked_deformation <= options_.rigid_dba_max_deformation;
+    const bool still = tracked_deformation < 0 || tracked_deformation <= options_.rigid_dba_max_deformation;
     if (baseline_ratio >= options_.rigid_dba_min_baseline && still) try_rigid(options_.rigid_dba_min_inliers);
   }
   if (!adjusted) {
@@ -513,8 +513,7 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
 void Mapper::ApplyShadingPrior(const cv::Mat& bgr, const cv::Mat& mask,
                                const std::unordered_map<int, cv::Point2f>& pixels,
                                std::vector<std::pair<int, Eigen::Vector3d>>* points) const {
-  cv::Mat grey;
-  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat grey = ToGrey(bgr);
   const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
   // Calibration: the frame's tracked points (buffer_.back() is this frame), whose distances
   // the map holds.

@@ -1,6 +1,5 @@
 #include "nrslam/mapping/monocular_initialiser.h"
 
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -89,8 +88,7 @@ InitialisationAttempt MonocularInitialiser::StartReference(int frame, const cv::
 }
 
 InitialisationAttempt MonocularInitialiser::Add(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
-  cv::Mat grey;
-  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat grey = ToGrey(bgr);
   if (reference_frame_ < 0) return StartReference(frame, grey, mask, "start");
   if (frame - reference_frame_ > options_.max_reference_age) return StartReference(frame, grey, mask, "reference too old");
 

@@ -4,7 +4,6 @@
 #include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -21,12 +20,6 @@
 
 namespace nrslam {
 namespace {
-
-cv::Mat Grey(const cv::Mat& bgr) {
-  cv::Mat grey;
-  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-  return grey;
-}
 
 ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType solver) {
   ceres::Solver::Options options;
@@ -83,7 +76,7 @@ FrameResult Tracker::Lost(FrameResult result, const std::string& why) {
 }
 
 FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv::Mat& depth_mm, const cv::Mat& mask) {
-  const cv::Mat grey = Grey(bgr);
+  const cv::Mat grey = ToGrey(bgr);
   FeatureOptions features = frontend_.features;
   features.max_features = options_.max_points;
   MapSeed seed;
@@ -124,7 +117,7 @@ FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv:
   if (static_cast<int>(seed.points.size()) < options_.min_points) {
     return Lost(result, "too few points to start a map (" + std::to_string(seed.points.size()) + ")");
   }
-  const cv::Mat grey = Grey(bgr);
+  const cv::Mat grey = ToGrey(bgr);
   std::map<int, std::vector<PointId>> groups;
   for (size_t i = 0; i < seed.points.size(); ++i) {
     const cv::Point2f& pixel = seed.pixels[i];
@@ -437,7 +430,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   if (state_ != TrackingState::kTracking) return Lost(result, "no map to track");
 
   // Short-term association.
-  const cv::Mat grey = Grey(bgr);
+  const cv::Mat grey = ToGrey(bgr);
   const auto pyramid = std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels);
   std::vector<cv::Point2f> guesses;
   for (const PointTrack& track : tracks_) {
