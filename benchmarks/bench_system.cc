@@ -4,7 +4,6 @@
 // not timed). Prints fps, mean ms per frame of each stage and the peak resident memory.
 // Targets: >= 15 fps; <= 1 GB on a 1000-frame run.
 //   bench_system [FRAMES=120] [PRESET...] [--set module.option=value ...]   e.g. bench_system 1000 sim-3
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +16,7 @@
 #include "bench_options.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
+#include "nrslam/util/memory_usage.h"
 #include "nrslam/util/source_revision.h"
 
 namespace fs = std::filesystem;
@@ -54,9 +54,7 @@ int main(int argc, char** argv) {
     fs::remove_all(work / preset);
     fs::remove_all(work / (preset + "-run"));
   }
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  std::printf("peak resident memory: %.0f MB (whole process, all runs)\n", usage.ru_maxrss / 1024.0);
+  std::printf("peak resident memory: %.0f MB (whole process, all runs)\n", nrslam::PeakResidentMemoryMb());
   fs::remove_all(work);
   return 0;
 }

@@ -289,7 +289,7 @@ TEST(Results, CsvNamesTheCodeOfEveryRun) {
   std::getline(csv, header);
   std::getline(csv, first);
   std::getline(csv, second);
-  EXPECT_EQ(header.substr(header.rfind(",fps,")), ",fps,revision,code,error");
+  EXPECT_EQ(header.substr(header.rfind(",fps,")), ",fps,peak_memory_mb,revision,code,error");
   EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
   EXPECT_EQ(second.substr(second.find(",,,\"")), ",,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
   std::filesystem::remove_all(folder);
@@ -1002,6 +1002,9 @@ TEST(BatchEvaluation, AnExternalResultIsScoredBesideTheRuns) {
   EXPECT_NEAR(results[2].rmse_mm, own.rmse_mm, 1e-5);
   EXPECT_NEAR(results[2].ate_mm, own.ate_mm, 1e-4);
   EXPECT_EQ(results[2].fps, 0.0);
+  // Our runs record their process's peak memory; another system's output has none of ours.
+  EXPECT_GT(results[0].peak_memory_mb, 10.0);
+  EXPECT_LT(results[2].peak_memory_mb, 0.0);
   std::stringstream table;
   PrintResults(results, table);
   EXPECT_NE(table.str().find("s-elsewhere"), std::string::npos) << table.str();
@@ -1136,6 +1139,27 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
     EXPECT_EQ(result.status, "failed");
     EXPECT_NE(result.error.find("cannot start"), std::string::npos) << result.error;
   }
+  std::filesystem::remove_all(folder);
+}
+
+// A run the system kills (as the out-of-memory killer would) is recorded with the memory it
+// had reached, which tells a run that ran out of memory from one that crashed.
+TEST(BatchEvaluation, AKilledRunIsRecordedWithItsPeakMemory) {
+  const auto folder = UniqueTempFolder("batch_killed");
+  EvaluationPlan plan;
+  // The shell holds the 32 MiB it reads into its variable, then kills itself.
+  const std::filesystem::path grower =
+      StandInRunner(folder, "x=$(head -c 33554432 /dev/zero | tr '\\0' a)\nkill -KILL $$\n", 1, &plan);
+  ExecutePlan(plan, Programs{kPrograms.simulate, grower, kPrograms.import, kPrograms.eval}, 1, [](const std::string&) {});
+  const std::vector<RunResult> results = CollectResults(plan);
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].status, "failed");
+  const std::string& error = results[0].error;
+  const size_t at = error.find("killed by signal 9 (Killed) at a peak of ");
+  ASSERT_NE(at, std::string::npos) << error;
+  const double peak_mb = std::stod(error.substr(at + std::string("killed by signal 9 (Killed) at a peak of ").size()));
+  EXPECT_GE(peak_mb, 32.0) << error;
+  EXPECT_LT(peak_mb, 1024.0) << error;
   std::filesystem::remove_all(folder);
 }
 

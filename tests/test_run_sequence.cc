@@ -487,6 +487,10 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   EXPECT_NEAR(per_frame.at("tracking_linear_solve").get<double>(), linear_solve / 40.0,
               1e-4 * linear_solve);  // metrics.csv holds 6 significant digits
   EXPECT_LT(per_frame.at("tracking_linear_solve").get<double>(), per_frame.at("tracking").get<double>());
+  // The process's peak memory: a test process holding images, pyramids and a Ceres problem
+  // holds more than 10 MB, and far less than the machine.
+  EXPECT_GT(summary.at("peak_memory_mb").get<double>(), 10.0);
+  EXPECT_LT(summary.at("peak_memory_mb").get<double>(), 8192.0);
 }
 
 // The full system from the images alone (depth only for the evaluation), 60 frames (320x240

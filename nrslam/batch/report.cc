@@ -237,19 +237,19 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
           "{text-align:left}td:nth-child(-n+2){white-space:nowrap}.failed{color:#b00}.plots,.images{display:flex;flex-wrap:wrap;gap:12px}"
           "figure{margin:0}section{margin-top:28px}</style></head><body>\n<h1>nrslam evaluation</h1>\n";
   html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
-          "<th>flat mm</th><th>1 scale mm</th><th>ATE mm</th><th>fps</th></tr>\n";
+          "<th>flat mm</th><th>1 scale mm</th><th>ATE mm</th><th>fps</th><th>MB</th></tr>\n";
   for (const RunResult& r : results) {
     const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
     html << "<tr><td><a href=\"#" << EscapeXml(Slug(r)) << "\">" << EscapeXml(key) << "</a></td>";
     if (r.status == "failed") {
-      html << "<td class=\"failed\">FAILED</td><td colspan=\"8\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
+      html << "<td class=\"failed\">FAILED</td><td colspan=\"9\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";
       continue;
     }
     html << "<td>" << r.status << "</td><td>" << InitFrameCell(r) << "</td><td>" << r.frames_tracked << "/"
          << r.frames_total << "</td><td>" << RmseCell(r, r.rmse_mm) << "</td><td>"
          << RmseCell(r, r.rmse_median_mm) << "</td><td>" << RecordedRmseCell(r, r.rmse_flat_mm) << "</td><td>"
          << RecordedRmseCell(r, r.rmse_map_scale_mm) << "</td><td>" << MillimetresCell(r.ate_mm) << "</td><td>" << FormatFixed(r.fps, 1)
-         << "</td></tr>\n";
+         << "</td><td>" << MegabytesCell(r.peak_memory_mb) << "</td></tr>\n";
   }
   html << "</table>\n<p>Code: " << EscapeXml(DescribeRevisions(results)) << "</p>\n" << SweepSection(results) << RigidSection(comparisons) << SeedSection(seed_groups);
   for (const RunResult& r : results) html << RunSection(r, folder);

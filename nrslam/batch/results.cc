@@ -44,6 +44,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->rmse_map_scale_mm = NumberOr(json, "rmse_map_scale_mm", -1.0);
   result->rmse_median_scale_mm = NumberOr(json, "rmse_median_scale_mm", -1.0);
   result->fps = json.value("fps", 0.0);
+  result->peak_memory_mb = NumberOr(json, "peak_memory_mb", -1.0);
   result->ate_mm = NumberOr(json, "ate_rmse_mm", -1.0);
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
@@ -208,6 +209,8 @@ double MeanOfRecorded(const std::vector<double>& figures) {
 
 std::string MillimetresCell(double mm) { return mm >= 0 ? FormatFixed(mm, 3) : "-"; }
 
+std::string MegabytesCell(double mb) { return mb >= 0 ? FormatFixed(mb, 0) : "-"; }
+
 std::string CompareCode(const std::vector<std::string>& codes_a, const std::vector<std::string>& codes_b) {
   const auto recorded = [](const std::vector<std::string>& codes) {
     return !codes.empty() && std::none_of(codes.begin(), codes.end(), [](const std::string& c) { return c.empty(); });
@@ -270,7 +273,8 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
                     {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
                     {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
-                    {"ate_rmse_mm", RecordedNumber(r.ate_mm)}, {"fps", r.fps}, {"run_folder", r.run_folder},
+                    {"ate_rmse_mm", RecordedNumber(r.ate_mm)}, {"fps", r.fps},
+                    {"peak_memory_mb", RecordedNumber(r.peak_memory_mb)}, {"run_folder", r.run_folder},
                     {"revision", r.revision.empty() ? Json() : Json(r.revision)},
                     {"code", r.code.empty() ? Json() : Json(r.code)},
                     {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
@@ -308,12 +312,13 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
-         "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,revision,code,error\n";
+         "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
-        << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
+        << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
+        << RecordedField(r.peak_memory_mb) << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
 }
 
@@ -326,7 +331,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   for (const RunResult& r : results) swept |= !r.label.empty();
   std::vector<std::string> header = {"sequence"};
   if (swept) header.push_back("sweep point");
-  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "flat mm", "1 scale mm", "ATE mm", "fps"}) {
+  for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "flat mm", "1 scale mm", "ATE mm", "fps", "MB"}) {
     header.push_back(column);
   }
   TextTable table(header);
@@ -334,13 +339,14 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     std::vector<std::string> row = {r.sequence};
     if (swept) row.push_back(r.label);
     if (r.status == "failed") {
-      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
+      for (const char* cell : {"FAILED", "-", "-", "-", "-", "-", "-", "-", "-", "-"}) row.push_back(cell);
     } else {
       row.insert(row.end(), {r.status, InitFrameCell(r),
                              std::to_string(r.frames_tracked) + "/" + std::to_string(r.frames_total),
                              RmseCell(r, r.rmse_mm), RmseCell(r, r.rmse_median_mm), RecordedRmseCell(r, r.rmse_flat_mm),
                              RecordedRmseCell(r, r.rmse_map_scale_mm), MillimetresCell(r.ate_mm),
-                             r.fps > 0 ? FormatFixed(r.fps, 1) : "-"});  // an external result has none
+                             r.fps > 0 ? FormatFixed(r.fps, 1) : "-",  // an external result has neither
+                             MegabytesCell(r.peak_memory_mb)});
     }
     table.AddRow(row);
   }

@@ -21,6 +21,7 @@ struct RunResult {
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
+  double peak_memory_mb = -1;       // the run process's peak resident memory; negative: not recorded
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
   double rmse_flat_mm = -1;         // what a map at one depth scores on the same points; negative: not recorded
   // The same frames at one scale per map (its drift counts) and at each frame's median ratio
@@ -91,6 +92,8 @@ double MeanOfRecorded(const std::vector<double>& figures);
 // A figure in mm that may be missing, such as a trajectory error or a mean of the map-scale
 // RMSE, as a table shows it: "-" when there is none (negative).
 std::string MillimetresCell(double mm);
+// A run's peak memory as a table shows it: whole MB, "-" when not recorded (negative).
+std::string MegabytesCell(double mb);
 // The same figure as a CSV field: empty when there is none (negative).
 std::string RecordedField(double value);
 

@@ -48,6 +48,7 @@ std::string DescribeSummary(const RunSummary& summary) {
   }
   if (summary.trajectory_error.evaluated) text << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
   if (summary.fps > 0) text << summary.fps << " fps";
+  if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
   return text.str();
@@ -123,6 +124,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_evaluated", summary.frames_evaluated},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},
+                      {"peak_memory_mb", summary.peak_memory_mb > 0 ? nlohmann::json(summary.peak_memory_mb) : nlohmann::json()},
                       {"ms_per_frame", {{"initialisation", summary.ms_initialisation},
                                         {"tracking", summary.ms_tracking},
                                         {"tracking_linear_solve", summary.ms_tracking_linear_solve},

@@ -34,6 +34,9 @@ struct RunSummary {
   int init_frame = -1;
   int frames_evaluated = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)
+  // The process's peak resident memory when the run ended (MB; util/memory_usage.h): the run's
+  // own under nrslam_run and nrslam_eval, which give each sequence its own process. 0: not measured.
+  double peak_memory_mb = 0;
   // Mean milliseconds per processed frame in each stage (the mapping stages run on some frames only).
   double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
   double ms_tracking_linear_solve = 0;  // of ms_tracking: the joint solves' linear solver

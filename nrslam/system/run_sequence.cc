@@ -17,6 +17,7 @@
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/memory_usage.h"
 #include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
@@ -263,6 +264,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   io.Finish();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.fps = summary.frames_total / std::max(seconds, 1e-9);
+  summary.peak_memory_mb = PeakResidentMemoryMb();
   summary.ms_initialisation = ms_initialisation / summary.frames_total;
   summary.ms_tracking = ms_tracking / summary.frames_total;
   summary.ms_tracking_linear_solve = ms_tracking_linear_solve / summary.frames_total;

@@ -2,10 +2,12 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 
 #include <chrono>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <map>
@@ -23,7 +25,11 @@ std::string ProcessOutcome::Describe() const {
     text << "timed out after " << timed_out_after_seconds << " s (killed)";
     return text.str();
   }
-  if (signal != 0) return "killed by signal " + std::to_string(signal) + " (" + strsignal(signal) + ")";
+  if (signal != 0) {
+    std::string text = "killed by signal " + std::to_string(signal) + " (" + strsignal(signal) + ")";
+    if (peak_memory_mb > 0) text += " at a peak of " + std::to_string(std::lround(peak_memory_mb)) + " MB";
+    return text;
+  }
   return "exit code " + std::to_string(exit_code);
 }
 
@@ -85,8 +91,9 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
     bool any_deadline = false;
     for (const auto& [pid, child] : running) any_deadline |= child.deadline != Clock::time_point::max();
     int status = 0;
+    rusage usage{};
     // With a deadline to watch, poll (every 20 ms) instead of blocking until a child ends.
-    const pid_t pid = waitpid(-1, &status, any_deadline ? WNOHANG : 0);
+    const pid_t pid = wait4(-1, &status, any_deadline ? WNOHANG : 0, &usage);
     if (pid == 0) {
       const Clock::time_point now = Clock::now();
       for (auto& [child_pid, child] : running) {
@@ -111,6 +118,7 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
     ProcessOutcome& outcome = outcomes[index];
     if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
     if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
+    outcome.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
     running.erase(found);
     if (done) done(index, outcome);
   }
