@@ -4,10 +4,14 @@
 
 namespace nrslam {
 
+double MaxResidentMb(const rusage& usage) {
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
+}
+
 double PeakResidentMemoryMb() {
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
+  return MaxResidentMb(usage);
 }
 
 }  // namespace nrslam

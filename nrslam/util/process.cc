@@ -14,6 +14,8 @@
 #include <sstream>
 #include <thread>
 
+#include "nrslam/util/memory_usage.h"
+
 extern char** environ;
 
 namespace nrslam {
@@ -118,7 +120,7 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
     ProcessOutcome& outcome = outcomes[index];
     if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
     if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
-    outcome.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
+    outcome.peak_memory_mb = MaxResidentMb(usage);
     running.erase(found);
     if (done) done(index, outcome);
   }
