@@ -289,9 +289,35 @@ TEST(Results, CsvNamesTheCodeOfEveryRun) {
   std::getline(csv, header);
   std::getline(csv, first);
   std::getline(csv, second);
-  EXPECT_EQ(header.substr(header.rfind(",fps,")), ",fps,peak_memory_mb,revision,code,error");
+  EXPECT_EQ(header.substr(header.rfind(",fps,")),
+            ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,error");
   EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
   EXPECT_EQ(second.substr(second.find(",,,\"")), ",,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
+  std::filesystem::remove_all(folder);
+}
+
+TEST(Results, BirthErrorsRoundTripAndStayEmptyWhereNoneWasScored) {
+  const auto folder = UniqueTempFolder("results_births");
+  RunResult scored = Result("a", 1.5, 60);
+  scored.births_evaluated = 12;
+  scored.birth_log_error_mean = -0.25;
+  scored.birth_log_error_median = 0.125;
+  const RunResult none = Result("b", 1.0, 60);
+  WriteResults({scored, none}, folder);
+  const std::vector<RunResult> read = ReadResults(folder);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].births_evaluated, 12);
+  EXPECT_EQ(read[0].birth_log_error_mean, std::optional<double>(-0.25));
+  EXPECT_EQ(read[0].birth_log_error_median, std::optional<double>(0.125));
+  EXPECT_EQ(read[1].births_evaluated, 0);
+  EXPECT_FALSE(read[1].birth_log_error_mean || read[1].birth_log_error_median);
+  std::ifstream csv(folder / "results.csv");
+  std::string header, first, second;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  std::getline(csv, second);
+  EXPECT_NE(first.find(",12,-0.25,0.125,"), std::string::npos) << first;
+  EXPECT_NE(second.find(",0,,,"), std::string::npos) << second;
   std::filesystem::remove_all(folder);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "nrslam/eval/birth_errors.h"
 #include "nrslam/eval/common_points.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/eval/error_view.h"
@@ -357,6 +358,52 @@ TEST_F(ErrorViewTest, WithoutAScaleNothingIsScored) {
   ErrorViewOptions inverted;
   inverted.far_mm = 5;
   EXPECT_THROW(DrawErrorView(bgr_, depth_, points_, EvaluationOptions(), inverted), Error);
+}
+
+// Known answers: a map at half the truth's scale (true depth 20 mm everywhere but a hole), so
+// each frame's median ratio is 2 and a point's birth error is log(2·z / 20).
+TEST(BirthErrors, NewPointsAreScoredOnceAgainstTheirFramesScale) {
+  cv::Mat depth(40, 40, CV_32F, cv::Scalar(20.0f));
+  depth(cv::Rect(30, 30, 10, 10)) = 0.0f;  // no ground truth there
+  const auto at = [](double x, double z) { return DepthPoint{{x, 5.0}, z}; };
+  const std::vector<DepthPoint> map{at(1, 10), at(2, 10), at(3, 10), at(4, 10), at(5, 10)};
+  BirthErrors births;  // 5 points with ground truth make a frame's scale
+  births.AddFrame({0, 1, 2, 3, 4}, map, depth, true);  // the map's first frame: no births
+  EXPECT_TRUE(births.log_errors().empty());
+
+  // Frame 1: three new points, one 10 % too far, one 10 % too near, one without ground truth.
+  std::vector<DepthPoint> frame1 = map;
+  frame1.push_back(at(10, 11));
+  frame1.push_back(at(11, 9));
+  frame1.push_back({{35, 35}, 10});
+  births.AddFrame({0, 1, 2, 3, 4, 5, 6, 7}, frame1, depth, false);
+  ASSERT_EQ(births.log_errors().size(), 2u);
+  EXPECT_NEAR(births.log_errors()[0], std::log(1.1), 1e-12);
+  EXPECT_NEAR(births.log_errors()[1], std::log(0.9), 1e-12);
+
+  // Seen before: not born again, whatever its depth now. Born on a frame without ground truth,
+  // or with too few points for a scale: born unscored, and not scored later either.
+  births.AddFrame({0, 1, 2, 3, 4, 5, 8}, {at(1, 10), at(2, 10), at(3, 10), at(4, 10), at(5, 10), at(10, 30), at(12, 10)},
+                  cv::Mat(), false);
+  births.AddFrame({0, 1, 9}, {at(1, 10), at(2, 10), at(13, 10)}, depth, false);
+  births.AddFrame({0, 1, 2, 3, 4, 5, 8, 9}, frame1, depth, false);
+  EXPECT_EQ(births.log_errors().size(), 2u);
+  // A new map's first frame: its points are the map, not births.
+  births.AddFrame({20, 21, 22, 23, 24, 25}, {at(1, 5), at(2, 5), at(3, 5), at(4, 5), at(5, 5), at(6, 7)}, depth, true);
+  EXPECT_EQ(births.log_errors().size(), 2u);
+  // The frame's scale is the median ratio over all its points, new ones included: here 4.
+  births.AddFrame({20, 21, 22, 23, 24, 26}, {at(1, 5), at(2, 5), at(3, 5), at(4, 5), at(5, 5), at(7, 2.5)}, depth,
+                  false);
+  ASSERT_EQ(births.log_errors().size(), 3u);
+  EXPECT_NEAR(births.log_errors()[2], std::log(0.5), 1e-12);
+
+  const BirthErrorSummary summary = births.Summarise();
+  EXPECT_EQ(summary.births_evaluated, 3);
+  ASSERT_TRUE(summary.mean && summary.median);
+  EXPECT_NEAR(*summary.mean, (std::log(1.1) + std::log(0.9) + std::log(0.5)) / 3, 1e-12);
+  EXPECT_NEAR(*summary.median, std::log(0.9), 1e-12);
+  EXPECT_FALSE(BirthErrors().Summarise().mean);
+  EXPECT_THROW(births.AddFrame({1, 2}, map, depth, false), Error);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/deformation/deformation_graph.h"
+#include "nrslam/eval/birth_errors.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
@@ -146,6 +147,9 @@ TEST_F(RunSequenceTest, SummaryRmseIsRecomputableFromPointsCsvAndGroundTruth) {
   EXPECT_NEAR(recomputed.rmse_flat_mm, summary.at("rmse_flat_mm").get<double>(), 1e-5);
   EXPECT_LT(summary.at("rmse_mm").get<double>(), 0.5 * summary.at("rmse_flat_mm").get<double>());
   EXPECT_EQ(summary.at("frames_tracked").get<int>(), 40);
+  // Tracking alone makes no points: nothing is born after the map's first frame.
+  EXPECT_EQ(summary.at("births_evaluated").get<int>(), 0);
+  EXPECT_TRUE(summary.at("birth_log_error_mean").is_null());
 }
 
 TEST_F(RunSequenceTest, TrajectoryErrorIsRecomputableFromTheTumFilesAndSmall) {
@@ -500,36 +504,32 @@ struct MonocularOutcome {
   int new_points = 0;     // tracked points that were not in the initial map
   int deformable_candidates = 0;  // summed over metrics.csv
   int rigid_dba = 0, deformable_dba = 0;  // windows after the warm-up, by the model selected (run.log)
-  // |log(s·z / true depth)| of each new point on the frame it was first tracked, with s that
-  // frame's median ratio of true to estimated depth (the scale that centres log errors; the
-  // evaluator's least-squares scale leans towards the far points): how well new points are
-  // placed. Their median, and the fraction off by more than a factor of 2.
+  // log(s·z / true depth) of each new point on the frame it was first tracked, with s that
+  // frame's median ratio of true to estimated depth (eval/birth_errors.h), from points.csv.
+  std::vector<double> birth_log_errors;
+  // How well new points are placed: the median of those errors' sizes, and the fraction off
+  // by more than a factor of 2.
   double new_point_log_depth_error = 0;
   double new_point_gross_error_fraction = 0;
 };
 
+// log(s·z / true depth) of each new point on the frame it was first tracked, recomputed from
+// points.csv as the evaluator does it for summary.json (eval/birth_errors.h).
 std::vector<double> NewPointLogDepthErrors(const std::vector<CsvPoint>& points, const SequenceReader& sequence,
                                            int init_frame) {
   std::map<int, std::vector<const CsvPoint*>> by_frame;
   for (const CsvPoint& p : points) by_frame[p.frame].push_back(&p);
-  std::set<PointId> seen;
-  std::vector<double> errors;
+  BirthErrors births;
   for (const auto& [frame, frame_points] : by_frame) {
-    const cv::Mat depth = sequence.ReadDepthMm(frame);
-    std::vector<std::pair<double, double>> new_points;  // estimated and true depth
-    std::vector<double> ratios;
+    std::vector<int64_t> ids;
+    std::vector<DepthPoint> depth_points;
     for (const CsvPoint* p : frame_points) {
-      const bool first_seen = seen.insert(p->id).second;
-      const std::optional<double> truth = SampleDepth(depth, {p->u, p->v});
-      if (!truth) continue;
-      ratios.push_back(*truth / p->z);
-      if (first_seen && frame != init_frame) new_points.emplace_back(p->z, *truth);
+      ids.push_back(p->id);
+      depth_points.push_back({{p->u, p->v}, p->z});
     }
-    if (new_points.empty()) continue;
-    const double scale = Median(ratios);
-    for (const auto& [estimated, truth] : new_points) errors.push_back(std::abs(std::log(scale * estimated / truth)));
+    births.AddFrame(ids, depth_points, sequence.ReadDepthMm(frame), frame == init_frame);
   }
-  return errors;
+  return births.log_errors();
 }
 
 int CountLines(const fs::path& file, const std::string& text) {
@@ -552,8 +552,9 @@ MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& op
   for (const CsvPoint& p : points) (p.frame == outcome.summary.init_frame ? initial : later).insert(p.id);
   for (PointId id : later) outcome.new_points += initial.count(id) == 0;
   outcome.deformable_candidates = static_cast<int>(SumColumn(folder / "run" / "metrics.csv", "deformable_candidates"));
-  const std::vector<double> errors =
-      NewPointLogDepthErrors(points, SequenceReader(folder / "sequence"), outcome.summary.init_frame);
+  outcome.birth_log_errors = NewPointLogDepthErrors(points, SequenceReader(folder / "sequence"), outcome.summary.init_frame);
+  std::vector<double> errors;
+  for (double error : outcome.birth_log_errors) errors.push_back(std::abs(error));
   if (!errors.empty()) {
     outcome.new_point_log_depth_error = Median(errors);
     outcome.new_point_gross_error_fraction =
@@ -632,6 +633,12 @@ TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
   // Model selection leaves the DBA deformable where one shape does not fit (measured: 4 of 7
   // windows after the warm-up).
   EXPECT_GT(outcome.deformable_dba, 0);
+  // summary.json's birth errors are those of the points points.csv says were new.
+  ASSERT_FALSE(outcome.birth_log_errors.empty());
+  EXPECT_EQ(outcome.summary.births.births_evaluated, static_cast<int>(outcome.birth_log_errors.size()));
+  ASSERT_TRUE(outcome.summary.births.mean && outcome.summary.births.median);
+  EXPECT_NEAR(*outcome.summary.births.mean, Mean(outcome.birth_log_errors), 1e-6);
+  EXPECT_NEAR(*outcome.summary.births.median, Median(outcome.birth_log_errors), 1e-6);
 }
 
 TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {

@@ -31,6 +31,11 @@ double NumberOr(const Json& json, const char* key, double fallback) {
   return found != json.end() && found->is_number() ? found->get<double>() : fallback;
 }
 
+std::optional<double> OptionalNumber(const Json& json, const char* key) {
+  const auto found = json.find(key);
+  return found != json.end() && found->is_number() ? std::optional<double>(found->get<double>()) : std::nullopt;
+}
+
 // The figures a run's summary.json and a results.json row share, under the same keys.
 void ReadFigures(const Json& json, RunResult* result) {
   result->init_frame = json.value("init_frame", -1);
@@ -46,6 +51,9 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->fps = json.value("fps", 0.0);
   result->peak_memory_mb = NumberOr(json, "peak_memory_mb", -1.0);
   result->ate_mm = NumberOr(json, "ate_rmse_mm", -1.0);
+  result->births_evaluated = json.value("births_evaluated", 0);
+  result->birth_log_error_mean = OptionalNumber(json, "birth_log_error_mean");
+  result->birth_log_error_median = OptionalNumber(json, "birth_log_error_median");
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
     result->stop_reason = reason->get<std::string>();
@@ -260,8 +268,15 @@ std::string RecordedField(double value) {
 }
 
 namespace {
-// A figure that may not have been recorded (negative) as JSON: null then.
+// A figure that may not have been recorded (negative, or none) as JSON: null then.
 Json RecordedNumber(double value) { return value >= 0 ? Json(value) : Json(); }
+Json RecordedNumber(const std::optional<double>& value) { return value ? Json(*value) : Json(); }
+
+std::string RecordedField(const std::optional<double>& value) {
+  std::ostringstream field;
+  if (value) field << *value;
+  return field.str();
+}
 }  // namespace
 
 Json ToJson(const std::vector<RunResult>& results) {
@@ -274,7 +289,10 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
                     {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
                     {"ate_rmse_mm", RecordedNumber(r.ate_mm)}, {"fps", r.fps},
-                    {"peak_memory_mb", RecordedNumber(r.peak_memory_mb)}, {"run_folder", r.run_folder},
+                    {"peak_memory_mb", RecordedNumber(r.peak_memory_mb)},
+                    {"births_evaluated", r.births_evaluated},
+                    {"birth_log_error_mean", RecordedNumber(r.birth_log_error_mean)},
+                    {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)}, {"run_folder", r.run_folder},
                     {"revision", r.revision.empty() ? Json() : Json(r.revision)},
                     {"code", r.code.empty() ? Json() : Json(r.code)},
                     {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
@@ -312,13 +330,15 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
-         "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,revision,code,error\n";
+         "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,"
+         "birth_log_error_mean,birth_log_error_median,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
-        << RecordedField(r.peak_memory_mb) << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
+        << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
+        << ',' << RecordedField(r.birth_log_error_median) << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
 }
 

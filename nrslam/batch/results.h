@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ struct RunResult {
   // The same frames at one scale per map (its drift counts) and at each frame's median ratio
   // (eval/depth_evaluation.h, OtherAlignments); negative: not recorded.
   double rmse_map_scale_mm = -1, rmse_median_scale_mm = -1;
+  // How far from the map's scale new points were born (eval/birth_errors.h): how many were
+  // scored, and the mean and median of their log depth errors (none: no birth scored).
+  int births_evaluated = 0;
+  std::optional<double> birth_log_error_mean, birth_log_error_median;
   std::string run_folder;
   std::string revision;             // the code that made the run (its config.json); "" when not recorded
   std::string code;                 // that code's fingerprint (CodeFingerprint()); "" when not recorded

@@ -178,6 +178,14 @@ SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames) {
   return metrics;
 }
 
+double MedianRatioScale(const std::vector<double>& estimated, const std::vector<double>& groundtruth) {
+  std::vector<double> ratios;
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    if (estimated[i] > 0) ratios.push_back(groundtruth[i] / estimated[i]);
+  }
+  return ratios.empty() ? 0.0 : Median(ratios);
+}
+
 OtherAlignments EvaluateOtherAlignments(const std::vector<FrameEvaluation>& frames, const EvaluationOptions& options) {
   std::map<int, std::pair<std::vector<double>, std::vector<double>>> pooled;  // per map: estimates, truths
   for (const FrameEvaluation& frame : frames) {
@@ -193,13 +201,9 @@ OtherAlignments EvaluateOtherAlignments(const std::vector<FrameEvaluation>& fram
   for (const FrameEvaluation& frame : frames) {
     if (!frame.evaluated) continue;
     if (frame.estimated.empty()) throw Error("EvaluateOtherAlignments: a frame evaluated without its pairs");
-    std::vector<double> ratios;
-    for (size_t i = 0; i < frame.estimated.size(); ++i) {
-      if (frame.estimated[i] > 0) ratios.push_back(frame.groundtruth[i] / frame.estimated[i]);
-    }
     // With no estimate in front of the camera there is no ratio; scale 0 scores every estimate
     // as depth 0, so the frame gets the RMSE of its true depths.
-    const double median_scale = ratios.empty() ? 0.0 : Median(ratios);
+    const double median_scale = MedianRatioScale(frame.estimated, frame.groundtruth);
     at_map_scale.push_back(
         EvaluateDepthPairsAtScale(frame.estimated, frame.groundtruth, map_scale.at(frame.map), options).rmse_mm);
     at_median_scale.push_back(EvaluateDepthPairsAtScale(frame.estimated, frame.groundtruth, median_scale, options).rmse_mm);

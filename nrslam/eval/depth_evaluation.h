@@ -81,6 +81,9 @@ struct SequenceMetrics {
 };
 SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames);
 
+// median(z_gt / z_est) over the pairs whose estimate is in front of the camera; 0 without one.
+double MedianRatioScale(const std::vector<double>& estimated, const std::vector<double>& groundtruth);
+
 // The evaluated frames (with their pairs) scored at other scales than their own, each frame's
 // RMSE trimmed as EvaluateDepthPairs trims, and averaged over the frames like rmse_mm:
 //   map scale:    one scale per map, fitted as a frame's is (trimmed least squares) to all of

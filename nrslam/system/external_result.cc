@@ -241,6 +241,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned(1);
+  BirthErrors births(evaluation.min_points);  // the first frame with estimates starts the one map
   const std::vector<EstimatedPoint> none;
   const std::string no_estimate = "no estimate of this frame in " + result.estimates.string();
   for (int frame = 0; frame < reader.frame_count(); ++frame) {
@@ -257,11 +258,16 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     if (tracked) {
       std::vector<DepthPoint> depth_points;
       for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
+      cv::Mat depth_mm;
       if (reader.has_depth() && !points.empty()) {
-        frame_evaluation = EvaluateFrame(depth_points, reader.ReadDepthMm(frame), evaluation);
+        depth_mm = reader.ReadDepthMm(frame);
+        frame_evaluation = EvaluateFrame(depth_points, depth_mm, evaluation);
         // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
         if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
       }
+      std::vector<int64_t> ids;
+      for (const EstimatedPoint& point : points) ids.push_back(point.id);
+      births.AddFrame(ids, depth_points, depth_mm, frame == summary.init_frame);
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));
@@ -297,6 +303,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << ",0,0,0,0,0,0,0,0,\"" << (tracked ? "" : "no estimate") << "\"\n";
   }
   AggregateInto(&summary, evaluations, aligned, evaluation);
+  summary.births = births.Summarise();
   WriteTum(out / "trajectory.tum", trajectory);
   WriteSummaryJson(out / "summary.json", summary, {{"init", "external"}, {"mapping", nullptr}, {"mode", "external"}});
   return summary;

@@ -47,6 +47,10 @@ std::string DescribeSummary(const RunSummary& summary) {
     text << "no ground truth, no RMSE  ";
   }
   if (summary.trajectory_error.evaluated) text << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
+  if (summary.births.mean) {
+    text << "new points born at log depth error " << *summary.births.mean << " (median " << *summary.births.median
+         << ", " << summary.births.births_evaluated << " points)  ";
+  }
   if (summary.fps > 0) text << summary.fps << " fps";
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
@@ -135,6 +139,10 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"ate_rmse_mm", trajectory_error.evaluated ? nlohmann::json(trajectory_error.rmse_mm) : nlohmann::json()},
                       {"ate_scale", trajectory_error.evaluated ? nlohmann::json(trajectory_error.scale) : nlohmann::json()},
                       {"ate_frames", trajectory_error.poses},
+                      // null without new points scored (eval/birth_errors.h)
+                      {"births_evaluated", summary.births.births_evaluated},
+                      {"birth_log_error_mean", summary.births.mean ? nlohmann::json(*summary.births.mean) : nlohmann::json()},
+                      {"birth_log_error_median", summary.births.median ? nlohmann::json(*summary.births.median) : nlohmann::json()},
                       {"map_points", summary.map_points}};
   json.update(provenance);
   json["status"] = summary.Status();

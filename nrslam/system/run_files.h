@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "nrslam/eval/birth_errors.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/eval/trajectory_error.h"
 
@@ -41,6 +42,7 @@ struct RunSummary {
   double ms_initialisation = 0, ms_tracking = 0, ms_dba = 0, ms_triangulation = 0;
   double ms_tracking_linear_solve = 0;  // of ms_tracking: the joint solves' linear solver
   TrajectoryError trajectory_error;  // camera centres aligned to the ground-truth poses per map
+  BirthErrorSummary births;          // how far from the map's scale new points were born
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
   // A run that ends without tracking: the first frame of that final stretch and its note (why

@@ -127,6 +127,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   // earlier maps, so that an id names one point of the whole run.
   int64_t id_base = 0;
   int64_t map_points = 0;  // points of the current map, as of the last frame tracked
+  int map_start_frame = -1;  // the frame the current map started on: its points are not births
+  BirthErrors births(options.evaluation.min_points);
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
@@ -135,6 +137,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     ++maps;
     id_base += map_points;
     map_points = 0;
+    map_start_frame = started.frame;
     if (summary.init_frame < 0) summary.init_frame = started.frame;
   };
   std::vector<FrameEvaluation> evaluations;
@@ -223,10 +226,12 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
             reader.groundtruth()[static_cast<size_t>(frame)].world_from_camera.translation);
       }
       map_points = static_cast<int64_t>(tracker.map().size());
+      std::vector<int64_t> ids;
       for (const TrackedPoint& point : result.points) {
         const Eigen::Vector3d world = tracker.map().point(point.id).position;
         const double z = (result.cam_from_world * world).z();
         depth_points.push_back({cv::Point2d(point.pixel.x, point.pixel.y), z});
+        ids.push_back(id_base + point.id);
         points_csv << frame << ',' << id_base + point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
                    << world.x() << ',' << world.y() << ',' << world.z() << ','
                    << (point.reassociated ? "reassociated" : "tracked") << '\n';
@@ -237,6 +242,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
         if (evaluation.evaluated) evaluations.push_back(std::move(evaluation));
       }
+      // Every tracked frame, with ground truth or not: a point is born once, where it first appears.
+      births.AddFrame(ids, depth_points, depth_mm, frame == map_start_frame);
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
       io.Write(out / "depth" / FrameFileName(frame),
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
@@ -273,6 +280,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.maps = maps;
   summary.map_points = tracker.map().size();
   AggregateInto(&summary, evaluations, aligned_maps, options.evaluation);
+  summary.births = births.Summarise();
 
   WriteTum(out / "trajectory.tum", trajectory);
   WritePly(out / "map.ply", tracker.map());

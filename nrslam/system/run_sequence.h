@@ -7,7 +7,8 @@
 //   metrics.csv     per frame: state, points, outliers, scale, RMSE, flat-map RMSE, ms per stage
 //   summary.json    rmse_mm, rmse_median_mm, rmse_pooled_mm, rmse_flat_mm, rmse_map_scale_mm,
 //                   rmse_median_scale_mm, frames_tracked, frames_total, init_frame, fps, peak_memory_mb,
-//                   ms per stage, maps, map_points and the run's status
+//                   ms per stage, maps, map_points, how far from the map's scale new points
+//                   were born (births_evaluated, birth_log_error_mean / _median) and the status
 //   map.ply         the final map points, coloured
 //   run.log         what happened, in words
 #pragma once

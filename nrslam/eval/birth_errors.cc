@@ -1,0 +1,44 @@
+#include "nrslam/eval/birth_errors.h"
+
+#include <cmath>
+
+#include "nrslam/util/error.h"
+#include "nrslam/util/median.h"
+
+namespace nrslam {
+
+void BirthErrors::AddFrame(const std::vector<int64_t>& ids, const std::vector<DepthPoint>& points,
+                           const cv::Mat& depth_mm, bool map_start) {
+  if (ids.size() != points.size()) throw Error("BirthErrors: ids and points differ in number");
+  std::vector<size_t> born;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    if (seen_.insert(ids[i]).second && !map_start) born.push_back(i);
+  }
+  if (born.empty() || depth_mm.empty()) return;
+  std::vector<std::optional<double>> truth(points.size());
+  std::vector<double> estimated, groundtruth;
+  for (size_t i = 0; i < points.size(); ++i) {
+    truth[i] = SampleDepth(depth_mm, points[i].pixel);
+    if (!truth[i]) continue;
+    estimated.push_back(points[i].depth);
+    groundtruth.push_back(*truth[i]);
+  }
+  if (static_cast<int>(estimated.size()) < min_points_) return;
+  const double scale = MedianRatioScale(estimated, groundtruth);
+  if (!(scale > 0)) return;
+  for (size_t i : born) {
+    const double estimate = scale * points[i].depth;
+    if (truth[i] && estimate > 0 && std::isfinite(estimate)) log_errors_.push_back(std::log(estimate / *truth[i]));
+  }
+}
+
+BirthErrorSummary BirthErrors::Summarise() const {
+  BirthErrorSummary summary;
+  summary.births_evaluated = static_cast<int>(log_errors_.size());
+  if (log_errors_.empty()) return summary;
+  summary.mean = Mean(log_errors_);
+  summary.median = Median(log_errors_);
+  return summary;
+}
+
+}  // namespace nrslam
