@@ -13,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -255,8 +256,39 @@ TEST_F(RunSequenceTest, ExternalDepthImagesScoreAsKnown) {
   EXPECT_NEAR(Number(metrics[3], "scale"), 2.0, 1e-9);
   EXPECT_EQ(metrics[5].at("state"), "lost");
   EXPECT_GT(Number(metrics[3], "points"), 1000);  // 80×60 samples, those on the surface
-  // Its ids number pixels, not points: nothing may pair them with a run's point ids.
+  // Its ids number pixels, not points: nothing may pair them with a run's point ids, and no
+  // point is born.
   EXPECT_THROW(CompareRunFolders(*base_ / "run", scored), Error);
+  EXPECT_EQ(summary.births.births_evaluated, 0);
+}
+
+// An external result whose ids name points gets its births scored: the run's own points, plus
+// one that appears at frame 10 a quarter too far, on the pixel of a point tracked there.
+TEST_F(RunSequenceTest, ExternalPointsBornTooFarAreScoredSo) {
+  const std::vector<CsvPoint> own = ReadPointsCsv(*base_ / "run" / "points.csv");
+  const auto write = [&](const fs::path& file, bool with_ids) {
+    std::ofstream csv(file);
+    csv << (with_ids ? "frame,point_id,u,v,z_est\n" : "frame,u,v,z_est\n");
+    std::optional<CsvPoint> added;
+    for (const CsvPoint& p : own) {
+      csv << p.frame << ',' << (with_ids ? std::to_string(p.id) + "," : "") << p.u << ',' << p.v << ',' << p.z << '\n';
+      if (p.frame >= 10 && !added) added = CsvPoint{p.frame, 1000000, p.u, p.v, 1.25 * p.z, {}};
+    }
+    ASSERT_TRUE(added);
+    csv << added->frame << ',' << (with_ids ? "1000000," : "") << added->u << ',' << added->v << ',' << added->z << '\n';
+  };
+  write(*base_ / "born_far.csv", true);
+  write(*base_ / "born_far_no_ids.csv", false);
+  ExternalResult external;
+  external.estimates = *base_ / "born_far.csv";
+  const RunSummary summary = ScoreExternalResult(*base_ / "sequence", external, EvaluationOptions{}, *base_ / "born_far");
+  ASSERT_EQ(summary.births.births_evaluated, 1);
+  // log 1.25 = 0.22, off by the tracked point's own depth error (well under 10 % here).
+  EXPECT_NEAR(*summary.births.mean, std::log(1.25), 0.1);
+  external.estimates = *base_ / "born_far_no_ids.csv";
+  const RunSummary without_ids =
+      ScoreExternalResult(*base_ / "sequence", external, EvaluationOptions{}, *base_ / "born_far_no_ids");
+  EXPECT_EQ(without_ids.births.births_evaluated, 0);  // rows of a frame name no point
 }
 
 TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {

@@ -241,7 +241,10 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned(1);
-  BirthErrors births(evaluation.min_points);  // the first frame with estimates starts the one map
+  // Births only where ids name points from frame to frame (not rows of a frame or pixels); the
+  // first frame with points is the one map's first.
+  BirthErrors births(evaluation.min_points);
+  bool had_points = false;
   const std::vector<EstimatedPoint> none;
   const std::string no_estimate = "no estimate of this frame in " + result.estimates.string();
   for (int frame = 0; frame < reader.frame_count(); ++frame) {
@@ -265,9 +268,12 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
         // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
         if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
       }
-      std::vector<int64_t> ids;
-      for (const EstimatedPoint& point : points) ids.push_back(point.id);
-      births.AddFrame(ids, depth_points, depth_mm, frame == summary.init_frame);
+      if (ids_name_points) {
+        std::vector<int64_t> ids;
+        for (const EstimatedPoint& point : points) ids.push_back(point.id);
+        births.AddFrame(ids, depth_points, depth_mm, !had_points && !points.empty());
+      }
+      had_points = had_points || !points.empty();
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));
