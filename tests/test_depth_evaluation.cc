@@ -367,8 +367,15 @@ TEST(BirthErrors, NewPointsAreScoredOnceAgainstTheirFramesScale) {
   depth(cv::Rect(30, 30, 10, 10)) = 0.0f;  // no ground truth there
   const auto at = [](double x, double z) { return DepthPoint{{x, 5.0}, z}; };
   const std::vector<DepthPoint> map{at(1, 10), at(2, 10), at(3, 10), at(4, 10), at(5, 10)};
-  BirthErrors births;  // 5 points with ground truth make a frame's scale
-  births.AddFrame({0, 1, 2, 3, 4}, map, depth, true);  // the map's first frame: no births
+  BirthErrors births;
+  // Each frame evaluated as the runner evaluates it: 5 points with ground truth make its scale.
+  const auto add = [&births](const std::vector<int64_t>& ids, const std::vector<DepthPoint>& points,
+                             const cv::Mat& depth_mm, bool map_start) {
+    const FrameEvaluation evaluation =
+        depth_mm.empty() ? FrameEvaluation{} : EvaluateFrame(points, depth_mm, EvaluationOptions{});
+    births.AddFrame(ids, points, depth_mm, evaluation, map_start);
+  };
+  add({0, 1, 2, 3, 4}, map, depth, true);  // the map's first frame: no births
   EXPECT_TRUE(births.log_errors().empty());
 
   // Frame 1: three new points, one 10 % too far, one 10 % too near, one without ground truth.
@@ -376,24 +383,23 @@ TEST(BirthErrors, NewPointsAreScoredOnceAgainstTheirFramesScale) {
   frame1.push_back(at(10, 11));
   frame1.push_back(at(11, 9));
   frame1.push_back({{35, 35}, 10});
-  births.AddFrame({0, 1, 2, 3, 4, 5, 6, 7}, frame1, depth, false);
+  add({0, 1, 2, 3, 4, 5, 6, 7}, frame1, depth, false);
   ASSERT_EQ(births.log_errors().size(), 2u);
   EXPECT_NEAR(births.log_errors()[0], std::log(1.1), 1e-12);
   EXPECT_NEAR(births.log_errors()[1], std::log(0.9), 1e-12);
 
   // Seen before: not born again, whatever its depth now. Born on a frame without ground truth,
   // or with too few points for a scale: born unscored, and not scored later either.
-  births.AddFrame({0, 1, 2, 3, 4, 5, 8}, {at(1, 10), at(2, 10), at(3, 10), at(4, 10), at(5, 10), at(10, 30), at(12, 10)},
-                  cv::Mat(), false);
-  births.AddFrame({0, 1, 9}, {at(1, 10), at(2, 10), at(13, 10)}, depth, false);
-  births.AddFrame({0, 1, 2, 3, 4, 5, 8, 9}, frame1, depth, false);
+  add({0, 1, 2, 3, 4, 5, 8}, {at(1, 10), at(2, 10), at(3, 10), at(4, 10), at(5, 10), at(10, 30), at(12, 10)},
+      cv::Mat(), false);
+  add({0, 1, 9}, {at(1, 10), at(2, 10), at(13, 10)}, depth, false);
+  add({0, 1, 2, 3, 4, 5, 8, 9}, frame1, depth, false);
   EXPECT_EQ(births.log_errors().size(), 2u);
   // A new map's first frame: its points are the map, not births.
-  births.AddFrame({20, 21, 22, 23, 24, 25}, {at(1, 5), at(2, 5), at(3, 5), at(4, 5), at(5, 5), at(6, 7)}, depth, true);
+  add({20, 21, 22, 23, 24, 25}, {at(1, 5), at(2, 5), at(3, 5), at(4, 5), at(5, 5), at(6, 7)}, depth, true);
   EXPECT_EQ(births.log_errors().size(), 2u);
   // The frame's scale is the median ratio over all its points, new ones included: here 4.
-  births.AddFrame({20, 21, 22, 23, 24, 26}, {at(1, 5), at(2, 5), at(3, 5), at(4, 5), at(5, 5), at(7, 2.5)}, depth,
-                  false);
+  add({20, 21, 22, 23, 24, 26}, {at(1, 5), at(2, 5), at(3, 5), at(4, 5), at(5, 5), at(7, 2.5)}, depth, false);
   ASSERT_EQ(births.log_errors().size(), 3u);
   EXPECT_NEAR(births.log_errors()[2], std::log(0.5), 1e-12);
 
@@ -403,7 +409,7 @@ TEST(BirthErrors, NewPointsAreScoredOnceAgainstTheirFramesScale) {
   EXPECT_NEAR(*summary.mean, (std::log(1.1) + std::log(0.9) + std::log(0.5)) / 3, 1e-12);
   EXPECT_NEAR(*summary.median, std::log(0.9), 1e-12);
   EXPECT_FALSE(BirthErrors().Summarise().mean);
-  EXPECT_THROW(births.AddFrame({1, 2}, map, depth, false), Error);
+  EXPECT_THROW(births.AddFrame({1, 2}, map, depth, EvaluateFrame(map, depth, EvaluationOptions{}), false), Error);
 }
 
 }  // namespace

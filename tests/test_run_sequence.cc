@@ -559,7 +559,9 @@ std::vector<double> NewPointLogDepthErrors(const std::vector<CsvPoint>& points, 
       ids.push_back(p->id);
       depth_points.push_back({{p->u, p->v}, p->z});
     }
-    births.AddFrame(ids, depth_points, sequence.ReadDepthMm(frame), frame == init_frame);
+    const cv::Mat depth = sequence.ReadDepthMm(frame);
+    births.AddFrame(ids, depth_points, depth, EvaluateFrame(depth_points, depth, EvaluationOptions{}),
+                    frame == init_frame);
   }
   return births.log_errors();
 }

@@ -8,27 +8,19 @@
 namespace nrslam {
 
 void BirthErrors::AddFrame(const std::vector<int64_t>& ids, const std::vector<DepthPoint>& points,
-                           const cv::Mat& depth_mm, bool map_start) {
+                           const cv::Mat& depth_mm, const FrameEvaluation& evaluation, bool map_start) {
   if (ids.size() != points.size()) throw Error("BirthErrors: ids and points differ in number");
   std::vector<size_t> born;
   for (size_t i = 0; i < ids.size(); ++i) {
     if (seen_.insert(ids[i]).second && !map_start) born.push_back(i);
   }
-  if (born.empty() || depth_mm.empty()) return;
-  std::vector<std::optional<double>> truth(points.size());
-  std::vector<double> estimated, groundtruth;
-  for (size_t i = 0; i < points.size(); ++i) {
-    truth[i] = SampleDepth(depth_mm, points[i].pixel);
-    if (!truth[i]) continue;
-    estimated.push_back(points[i].depth);
-    groundtruth.push_back(*truth[i]);
-  }
-  if (static_cast<int>(estimated.size()) < min_points_) return;
-  const double scale = MedianRatioScale(estimated, groundtruth);
+  if (born.empty() || !evaluation.evaluated) return;
+  const double scale = MedianRatioScale(evaluation.estimated, evaluation.groundtruth);
   if (!(scale > 0)) return;
   for (size_t i : born) {
+    const std::optional<double> truth = SampleDepth(depth_mm, points[i].pixel);
     const double estimate = scale * points[i].depth;
-    if (truth[i] && estimate > 0 && std::isfinite(estimate)) log_errors_.push_back(std::log(estimate / *truth[i]));
+    if (truth && estimate > 0 && std::isfinite(estimate)) log_errors_.push_back(std::log(estimate / *truth));
   }
 }
 

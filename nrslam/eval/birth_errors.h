@@ -28,19 +28,17 @@ struct BirthErrorSummary {
 
 class BirthErrors {
  public:
-  // Frames with fewer points with ground truth than `min_points` have no scale: their new
-  // points are born unscored.
-  explicit BirthErrors(int min_points = EvaluationOptions{}.min_points) : min_points_(min_points) {}
-  // One frame's points, frames in order; `ids` parallel to `points`; `depth_mm` empty when the
-  // frame has no ground truth. `map_start`: the frame started a map. Throws Error when `ids`
-  // and `points` differ in number.
+  // One frame's points, frames in order; `ids` parallel to `points`; `evaluation` the frame's
+  // EvaluateFrame of the same points (default: the frame has no ground truth), whose pairs give
+  // the scale. A frame that was not evaluated (no ground truth, fewer than min_points points
+  // with it) still sees its new points born, unscored. `map_start`: the frame started a map.
+  // Throws Error when `ids` and `points` differ in number.
   void AddFrame(const std::vector<int64_t>& ids, const std::vector<DepthPoint>& points, const cv::Mat& depth_mm,
-                bool map_start);
+                const FrameEvaluation& evaluation, bool map_start);
   const std::vector<double>& log_errors() const { return log_errors_; }  // one per scored birth
   BirthErrorSummary Summarise() const;
 
  private:
-  int min_points_;
   std::unordered_set<int64_t> seen_;
   std::vector<double> log_errors_;
 };

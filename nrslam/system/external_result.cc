@@ -243,7 +243,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   std::vector<TrajectorySegment> aligned(1);
   // Births only where ids name points from frame to frame (not rows of a frame or pixels); the
   // first frame with points is the one map's first.
-  BirthErrors births(evaluation.min_points);
+  BirthErrors births;
   bool had_points = false;
   const std::vector<EstimatedPoint> none;
   const std::string no_estimate = "no estimate of this frame in " + result.estimates.string();
@@ -265,15 +265,15 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
       if (reader.has_depth() && !points.empty()) {
         depth_mm = reader.ReadDepthMm(frame);
         frame_evaluation = EvaluateFrame(depth_points, depth_mm, evaluation);
-        // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
-        if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
       }
       if (ids_name_points) {
         std::vector<int64_t> ids;
         for (const EstimatedPoint& point : points) ids.push_back(point.id);
-        births.AddFrame(ids, depth_points, depth_mm, !had_points && !points.empty());
+        births.AddFrame(ids, depth_points, depth_mm, frame_evaluation, !had_points && !points.empty());
       }
       had_points = had_points || !points.empty();
+      // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
+      if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));

@@ -128,7 +128,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   int64_t id_base = 0;
   int64_t map_points = 0;  // points of the current map, as of the last frame tracked
   int map_start_frame = -1;  // the frame the current map started on: its points are not births
-  BirthErrors births(options.evaluation.min_points);
+  BirthErrors births;
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
@@ -232,18 +232,18 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         const double z = (result.cam_from_world * world).z();
         depth_points.push_back({cv::Point2d(point.pixel.x, point.pixel.y), z});
         ids.push_back(id_base + point.id);
-        points_csv << frame << ',' << id_base + point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
+        points_csv << frame << ',' << ids.back() << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
                    << world.x() << ',' << world.y() << ',' << world.z() << ','
                    << (point.reassociated ? "reassociated" : "tracked") << '\n';
       }
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         evaluation.map = maps;
-        // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
-        if (evaluation.evaluated) evaluations.push_back(std::move(evaluation));
       }
       // Every tracked frame, with ground truth or not: a point is born once, where it first appears.
-      births.AddFrame(ids, depth_points, depth_mm, frame == map_start_frame);
+      births.AddFrame(ids, depth_points, depth_mm, evaluation, frame == map_start_frame);
+      // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
+      if (evaluation.evaluated) evaluations.push_back(std::move(evaluation));
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
       io.Write(out / "depth" / FrameFileName(frame),
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
