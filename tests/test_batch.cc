@@ -23,6 +23,7 @@
 #include "nrslam/batch/seed_groups.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/error.h"
 #include "nrslam/util/source_revision.h"
 #include "temp_folder.h"
 
@@ -1164,6 +1165,43 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   for (const RunResult& result : CollectResults(plan)) {
     EXPECT_EQ(result.status, "failed");
     EXPECT_NE(result.error.find("cannot start"), std::string::npos) << result.error;
+  }
+  std::filesystem::remove_all(folder);
+}
+
+// Runs record the code of the nrslam_run that made them, and count as finished only when it
+// is the evaluator's: an nrslam_run built from other code (one tool rebuilt, not the others)
+// is refused before anything runs, not left to fail every run it finishes.
+TEST(BatchEvaluation, ARunnerBuiltFromOtherCodeIsRefusedBeforeAnythingRuns) {
+  const auto folder = UniqueTempFolder("batch_other_code");
+  const auto runner_answering = [&](const std::string& code, EvaluationPlan* plan) {
+    return StandInRunner(folder,
+                         "if [ \"$1\" = --version ]; then echo 'nrslam 0.1.0 (revision 0123abcd, code " + code +
+                             ")'; exit 0; fi\ntouch '" + (folder / "ran").string() + "'\n",
+                         2, plan);
+  };
+  EvaluationPlan plan;
+  const std::filesystem::path stale = runner_answering("0000deadbeef", &plan);
+  try {
+    ExecutePlan(plan, Programs{kPrograms.simulate, stale, kPrograms.import, kPrograms.eval}, 2, [](const std::string&) {});
+    ADD_FAILURE() << "a runner of other code was used";
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("built from other code (0000deadbeef)"), std::string::npos) << message;
+    EXPECT_NE(message.find(CodeFingerprint()), std::string::npos) << message;
+    EXPECT_NE(message.find("Rebuild every tool"), std::string::npos) << message;
+  }
+  EXPECT_FALSE(std::filesystem::exists(folder / "ran"));
+  EXPECT_FALSE(std::filesystem::exists(plan.runs[0].run_folder / "failure.json"));
+
+  // The same code passes the check; a run that then exits with 0 and writes nothing is a
+  // failure that says so, not "exit code 0".
+  const std::filesystem::path current = runner_answering(CodeFingerprint(), &plan);
+  ExecutePlan(plan, Programs{kPrograms.simulate, current, kPrograms.import, kPrograms.eval}, 2, [](const std::string&) {});
+  EXPECT_TRUE(std::filesystem::exists(folder / "ran"));
+  for (const RunResult& result : CollectResults(plan)) {
+    EXPECT_EQ(result.status, "failed");
+    EXPECT_NE(result.error.find("exited with 0 but left no finished run"), std::string::npos) << result.error;
   }
   std::filesystem::remove_all(folder);
 }

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/error.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 
@@ -275,8 +277,26 @@ bool RunIsFinished(const RunJob& run) {
   }
 }
 
+void CheckRunProgramCode(const std::filesystem::path& run_program) {
+  const std::optional<std::string> version = CommandOutput({run_program.string(), "--version"}, 5);
+  if (!version) return;
+  const std::string marker = "code ";
+  const size_t start = version->rfind(marker);
+  const size_t end = start == std::string::npos ? start : version->find(')', start);
+  if (end == std::string::npos) return;
+  const std::string code = version->substr(start + marker.size(), end - start - marker.size());
+  if (code != CodeFingerprint()) {
+    throw Error(run_program.string() + " is built from other code (" + code + ") than this nrslam_eval (" +
+                CodeFingerprint() + "); its runs would never count as finished. Rebuild every tool (e.g. make -C build)");
+  }
+}
+
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
                  const std::function<void(const std::string&)>& progress, double run_timeout_seconds) {
+  if (std::any_of(plan.runs.begin(), plan.runs.end(),
+                  [](const RunJob& run) { return !run.is_external() && !RunIsFinished(run); })) {
+    CheckRunProgramCode(programs.run);  // before anything is rendered or removed
+  }
   // Sequences first: several runs may share one.
   std::vector<Command> prepares;
   std::vector<size_t> prepare_index;
@@ -344,8 +364,9 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
       return;
     }
     const std::string why = LastLine(runs[k].log);
-    WriteFailure(run, "run", outcome.Describe() + (why.empty() ? "" : ": " + why));
-    progress(counter + name + " FAILED (" + outcome.Describe() + ")" + (why.empty() ? "" : ": " + why));
+    const std::string how = outcome.ok() ? "exited with 0 but left no finished run" : outcome.Describe();
+    WriteFailure(run, "run", how + (why.empty() ? "" : ": " + why));
+    progress(counter + name + " FAILED (" + how + ")" + (why.empty() ? "" : ": " + why));
   });
 }
 

@@ -85,9 +85,17 @@ std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Pr
 // code is run again rather than reported stale.
 bool RunIsFinished(const RunJob& run);
 
+// A run records the code fingerprint of the nrslam_run that made it, and RunIsFinished counts
+// it only when that is this program's. An nrslam_run built from other code (one tool rebuilt
+// and not the others) would have every run it finishes count as unfinished, and run again by
+// every evaluation: throws Error naming both fingerprints. Nothing happens when the program
+// does not answer --version; the runs then fail and say why.
+void CheckRunProgramCode(const std::filesystem::path& run_program);
+
 // Prepares what is missing, then runs what is not finished, `jobs` processes at a time.
 // `progress` gets one line per finished step. Failures are recorded in the run folders
-// (failure.json), never thrown. A run still going after `run_timeout_seconds` (wall clock;
+// (failure.json), never thrown; only an nrslam_run of other code throws, before anything
+// is run (CheckRunProgramCode). A run still going after `run_timeout_seconds` (wall clock;
 // 0: no limit) is killed and recorded as failed, so one sequence that hangs cannot stall a
 // batch; it is run again by the next evaluation into the same folder.
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,

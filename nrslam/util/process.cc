@@ -4,12 +4,16 @@
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <thread>
@@ -125,6 +129,20 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
     if (done) done(index, outcome);
   }
   return outcomes;
+}
+
+std::optional<std::string> CommandOutput(const std::vector<std::string>& argv, double timeout_seconds) {
+  static std::atomic<int> calls{0};
+  const std::filesystem::path log = std::filesystem::temp_directory_path() /
+                                    ("nrslam-output-" + std::to_string(getpid()) + "-" + std::to_string(calls++));
+  const ProcessOutcome outcome = RunCommands({Command{argv, log, timeout_seconds}}, 1).front();
+  std::ifstream stream(log);
+  std::string output((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  stream.close();
+  std::error_code ignored;
+  std::filesystem::remove(log, ignored);
+  if (!outcome.ok()) return std::nullopt;
+  return output;
 }
 
 std::string ShellLine(const std::vector<std::string>& argv) {

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,11 @@ struct ProcessOutcome {
 // thread) as each one finishes. Never throws for a child's failure: that is its outcome.
 std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
                                         const std::function<void(size_t index, const ProcessOutcome&)>& done = {});
+
+// Runs a command to its end and returns what it wrote (stdout and stderr); nullopt when it
+// could not be started, did not exit with 0 or ran past the timeout (then it is killed). For
+// short queries such as a program's --version, not for runs.
+std::optional<std::string> CommandOutput(const std::vector<std::string>& argv, double timeout_seconds);
 
 // A command as one line a POSIX shell runs as is (every argument single-quoted as needed).
 std::string ShellLine(const std::vector<std::string>& argv);
