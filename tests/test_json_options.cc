@@ -103,6 +103,14 @@ TEST(JsonOptions, DeformableGateSpanOptionsAreValidated) {
   EXPECT_EQ(WithAssignments(MappingOptions{}, {"shortest_gate_below_fraction=0"}).shortest_gate_below_fraction, 0.0);
 }
 
+TEST(JsonOptions, DeformableFitToleranceIsCeresDefaultAndAFraction) {
+  EXPECT_EQ(MappingOptions{}.deformable_function_tolerance, 1e-6);
+  const MappingOptions tight = WithAssignments(MappingOptions{}, {"deformable_function_tolerance=1e-14"});
+  EXPECT_EQ(OptionsFromJson<MappingOptions>(Json(tight), "test").deformable_function_tolerance, 1e-14);
+  EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_function_tolerance=0"}), Error);
+  EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_function_tolerance=1"}), Error);
+}
+
 TEST(JsonOptions, AFileThatIsNotJsonIsNamedWithWhatIsWrong) {
   const auto folder = UniqueTempFolder("json_file");
   std::filesystem::create_directories(folder);

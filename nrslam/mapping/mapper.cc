@@ -363,6 +363,7 @@ std::optional<Eigen::Vector3d> Mapper::TriangulateDeformable(const CandidateTrac
   }
   ceres::Solver::Options solver;
   solver.max_num_iterations = options_.deformable_iterations;
+  solver.function_tolerance = options_.deformable_function_tolerance;
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;

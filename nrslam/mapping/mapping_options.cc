@@ -50,6 +50,8 @@ void MappingOptions::Check() const {
   CheckOption(shortest_gate_below_fraction >= 0 && shortest_gate_below_fraction <= 1, "mapping",
               "shortest_gate_below_fraction must be in [0, 1]");
   CheckOption(model_selection_factor >= 1, "mapping", "model_selection_factor must be >= 1");
+  CheckOption(deformable_function_tolerance > 0 && deformable_function_tolerance < 1, "mapping",
+              "deformable_function_tolerance must be in (0, 1)");
 }
 
 }  // namespace nrslam
