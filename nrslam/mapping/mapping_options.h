@@ -153,10 +153,10 @@ struct MappingOptions {
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
   int deformable_iterations = 10;
   // The fit stops when an iteration lowers its cost by less than this fraction (Ceres's
-  // function_tolerance; 1e-6 is its default). Along a ray with little
-  // parallax the cost is nearly flat, so the fit stops a few steps from its seed: at 1e-14 the
-  // new points' depths follow their tracks more, but 14 of the 21 colon renderings came out
-  // worse and a 1000-frame run from depth lost its track (README, "Long runs").
+  // function_tolerance; 1e-6 is its default). Along a ray with little parallax the cost is
+  // nearly flat, so the fit stops a few steps from its seed: at 1e-14 the new points' depths
+  // follow their tracks more, but 14 of the 21 colon renderings came out worse and a
+  // 1000-frame run from depth lost its track (README, "Long runs").
   double deformable_function_tolerance = 1e-6;
   double flow_outlier_chi2 = 7.815;  // reject if more than half the flow residuals exceed it ...
   double reprojection_outlier_chi2 = 59.9;  // ... or more than half the reprojections exceed this
