@@ -4,6 +4,7 @@
 
 #include "nrslam/mapping/mapping_options.h"
 #include "nrslam/sim/sim_options.h"
+#include "nrslam/system/system_options.h"
 #include "nrslam/tracking/tracking_options.h"
 #include "nrslam/util/json_options.h"
 #include "temp_folder.h"
@@ -109,6 +110,18 @@ TEST(JsonOptions, DeformableFitToleranceIsCeresDefaultAndAFraction) {
   EXPECT_EQ(OptionsFromJson<MappingOptions>(Json(tight), "test").deformable_function_tolerance, 1e-14);
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_function_tolerance=0"}), Error);
   EXPECT_THROW(WithAssignments(MappingOptions{}, {"deformable_function_tolerance=1"}), Error);
+}
+
+TEST(JsonOptions, OnlyMinusOneMeansToTheEndOfTheSequence) {
+  EXPECT_EQ(WithAssignments(RunOptions{}, {"last_frame=-1"}).last_frame, -1);
+  EXPECT_EQ(WithAssignments(RunOptions{}, {"first_frame=10", "last_frame=11"}).last_frame, 11);
+  try {
+    WithAssignments(RunOptions{}, {"last_frame=-5"});  // not "all but the last five"
+    ADD_FAILURE() << "last_frame=-5 was accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("-1 (to the end)"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(WithAssignments(RunOptions{}, {"first_frame=10", "last_frame=10"}), Error);  // empty range
 }
 
 TEST(JsonOptions, AFileThatIsNotJsonIsNamedWithWhatIsWrong) {

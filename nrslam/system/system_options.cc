@@ -11,7 +11,10 @@ namespace nrslam {
 void RunOptions::Check() const {
   CheckOption(init == "depth" || init == "monocular", "run", "init must be depth or monocular, got '" + init + "'");
   CheckOption(first_frame >= 0, "run", "first_frame must be >= 0, got " + std::to_string(first_frame));
-  CheckOption(last_frame < 0 || last_frame > first_frame, "run",
+  // Only -1 means "to the end": -5 read as "all but the last 5" would run the whole sequence.
+  CheckOption(last_frame >= -1, "run",
+              "last_frame must be -1 (to the end) or a frame number, got " + std::to_string(last_frame));
+  CheckOption(last_frame == -1 || last_frame > first_frame, "run",
               "the frame range [first_frame, last_frame) = [" + std::to_string(first_frame) + ", " +
                   std::to_string(last_frame) + ") is empty (last_frame -1 = to the end)");
 }
