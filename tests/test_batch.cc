@@ -221,6 +221,18 @@ TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
   EXPECT_THROW(ParseSweep("nonsense=1,2"), Error);
   // A value the option cannot take is caught before anything runs.
   EXPECT_THROW(PlanEvaluation(manifest, {}, {ParseSweep("k=-1")}, folder / "out", folder / "cache"), Error);
+  // A value given twice would be two runs in one folder; one option swept twice (under any of
+  // its names) would leave one sweep without effect.
+  const auto refused = [&](const std::vector<Sweep>& grid, const std::string& message) {
+    try {
+      PlanEvaluation(manifest, {}, grid, folder / "out", folder / "cache");
+      ADD_FAILURE() << "accepted; expected: " << message;
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
+    }
+  };
+  refused({ParseSweep("k=1,2,1")}, "deformation.k: value 1 is given twice");
+  refused({ParseSweep("k=1"), ParseSweep("deformation.k=2")}, "deformation.k is swept twice");
   std::filesystem::remove_all(folder);
 }
 

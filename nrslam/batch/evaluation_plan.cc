@@ -127,6 +127,19 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
                               const std::vector<Sweep>& sweeps, const std::filesystem::path& out,
                               const std::filesystem::path& cache) {
   EvaluationPlan plan;
+  // A point given twice would be two runs writing into one folder at once; an option swept
+  // twice would leave one of its sweeps without effect.
+  for (size_t i = 0; i < sweeps.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (sweeps[j].path == sweeps[i].path) throw Error("--sweep: " + sweeps[i].path + " is swept twice");
+    }
+    for (size_t v = 0; v < sweeps[i].values.size(); ++v) {
+      if (std::find(sweeps[i].values.begin(), sweeps[i].values.begin() + v, sweeps[i].values[v]) !=
+          sweeps[i].values.begin() + v) {
+        throw Error("--sweep " + sweeps[i].path + ": value " + sweeps[i].values[v] + " is given twice");
+      }
+    }
+  }
   // The grid of sweep points, each a list of "path=value".
   std::vector<std::vector<std::string>> points = {{}};
   for (const Sweep& sweep : sweeps) {
