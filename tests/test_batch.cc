@@ -25,6 +25,7 @@
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_table.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -1181,6 +1182,15 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(Progress, DurationsReadAsAPersonWouldSayThem) {
+  EXPECT_EQ(FormatDuration(0), "0 s");
+  EXPECT_EQ(FormatDuration(-3), "0 s");
+  EXPECT_EQ(FormatDuration(42.4), "42 s");
+  EXPECT_EQ(FormatDuration(150), "3 min");
+  EXPECT_EQ(FormatDuration(89 * 60), "89 min");
+  EXPECT_EQ(FormatDuration(2 * 3600 + 5 * 60 + 10), "2 h 5 min");
+}
+
 // Runs record the code of the nrslam_run that made them, and count as finished only when it
 // is the evaluator's: an nrslam_run built from other code (one tool rebuilt, not the others)
 // is refused before anything runs, not left to fail every run it finishes.
@@ -1260,7 +1270,15 @@ TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
     "sequences": [{"name": "s", "preset": "sim-1", "simulate": )") + kTinySimulate + "}]}"));
   const EvaluationPlan plan = PlanEvaluation(manifest, {}, {ParseSweep("max_degree_D=4,8")}, folder / "out", folder / "cache");
   ASSERT_EQ(plan.runs.size(), 2u);
-  ExecutePlan(plan, kPrograms, 2, [](const std::string&) {});
+  std::vector<std::string> first_lines;
+  ExecutePlan(plan, kPrograms, 2, [&](const std::string& line) { first_lines.push_back(line); });
+  // Each run says how long it took; the first also how long the rest should take. (The
+  // render of the sequence comes first.)
+  ASSERT_EQ(first_lines.size(), 3u);
+  first_lines.erase(first_lines.begin());
+  EXPECT_TRUE(std::regex_search(first_lines[0], std::regex(R"(\[1/2\] s \[max_degree_D=\d\] done in \d+ s; about \d+ s left$)")))
+      << first_lines[0];
+  EXPECT_TRUE(std::regex_search(first_lines[1], std::regex(R"(\[2/2\] s \[max_degree_D=\d\] done in \d+ s$)"))) << first_lines[1];
   const std::vector<RunResult> first = CollectResults(plan);
   ASSERT_EQ(first[0].status, "ok") << first[0].error;
   ASSERT_EQ(first[1].status, "ok") << first[1].error;
@@ -1271,7 +1289,8 @@ TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
   ExecutePlan(plan, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0], "1 run(s) already finished, not run again");
-  EXPECT_NE(lines[1].find("[1/1] s [max_degree_D=8] done"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[1].find("[1/1] s [max_degree_D=8] done in "), std::string::npos) << lines[1];
+  EXPECT_EQ(lines[1].find("left"), std::string::npos) << lines[1];  // the last run: nothing left
   EXPECT_EQ(std::filesystem::last_write_time(plan.runs[0].run_folder / "summary.json"), untouched);
   const std::vector<RunResult> second = CollectResults(plan);
   EXPECT_DOUBLE_EQ(second[1].rmse_mm, first[1].rmse_mm);  // the same run, the same answer

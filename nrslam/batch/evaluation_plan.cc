@@ -1,6 +1,7 @@
 #include "nrslam/batch/evaluation_plan.h"
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <iomanip>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "nrslam/util/error.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 namespace {
@@ -368,12 +370,17 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
     progress(std::to_string(superseded) + " run(s) in the output folder had other options, another sequence, changed estimates or other code: run again");
   }
   size_t finished = 0;
+  const auto started = std::chrono::steady_clock::now();
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const RunJob& run = plan.runs[run_index[k]];
     const std::string name = run.sequence + (run.label.empty() ? "" : " [" + run.label + "]");
     const std::string counter = "[" + std::to_string(++finished) + "/" + std::to_string(runs.size()) + "] ";
     if (outcome.ok() && RunIsFinished(run)) {
-      progress(counter + name + " done");
+      // The batch's pace so far, over the runs left: a sweep of hours says when it will end.
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      const size_t left = runs.size() - finished;
+      progress(counter + name + " done in " + FormatDuration(outcome.wall_seconds) +
+               (left == 0 ? "" : "; about " + FormatDuration(elapsed / finished * left) + " left"));
       return;
     }
     const std::string why = LastLine(runs[k].log);

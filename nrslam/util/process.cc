@@ -73,6 +73,7 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
   using Clock = std::chrono::steady_clock;
   struct Running {
     size_t index;
+    Clock::time_point started;
     Clock::time_point deadline;  // Clock::time_point::max() without a timeout
   };
   std::vector<ProcessOutcome> outcomes(commands.size());
@@ -86,10 +87,11 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
         if (done) done(next, outcomes[next]);
       } else {
         const double timeout = commands[next].timeout_seconds;
+        const Clock::time_point started = Clock::now();
         const Clock::time_point deadline =
-            timeout > 0 ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout))
+            timeout > 0 ? started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout))
                         : Clock::time_point::max();
-        running[pid] = {next, deadline};
+        running[pid] = {next, started, deadline};
       }
       ++next;
     }
@@ -125,6 +127,7 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
     if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
     if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
     outcome.peak_memory_mb = MaxResidentMb(usage);
+    outcome.wall_seconds = std::chrono::duration<double>(Clock::now() - found->second.started).count();
     running.erase(found);
     if (done) done(index, outcome);
   }

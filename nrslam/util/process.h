@@ -25,6 +25,7 @@ struct ProcessOutcome {
   std::string error;   // when it could not be started
   double timed_out_after_seconds = 0;  // when it was killed for running past its timeout
   double peak_memory_mb = 0;  // the child's peak resident memory, once it has ended
+  double wall_seconds = 0;    // how long it ran, from its start to its end (wall clock)
   bool ok() const { return error.empty() && signal == 0 && exit_code == 0 && timed_out_after_seconds == 0; }
   // "exit code 1", "killed by signal 9 (Killed) at a peak of 23112 MB", "timed out after 60 s
   // (killed)", or the start error. The peak says whether a killed run was out of memory.

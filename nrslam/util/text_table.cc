@@ -1,6 +1,7 @@
 #include "nrslam/util/text_table.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 
@@ -25,6 +26,14 @@ void TextTable::Print(std::ostream& out) const {
   for (size_t w : widths) total += w;
   out << std::string(total + 2 * (widths.size() - 1), '-') << '\n';
   for (const auto& row : rows_) print_row(row);
+}
+
+std::string FormatDuration(double seconds) {
+  const long rounded = std::lround(std::max(0.0, seconds));
+  if (rounded < 90) return std::to_string(rounded) + " s";
+  const long minutes = std::lround(seconds / 60);
+  if (minutes < 90) return std::to_string(minutes) + " min";
+  return std::to_string(minutes / 60) + " h " + std::to_string(minutes % 60) + " min";
 }
 
 std::string Join(const std::vector<std::string>& items, const std::string& separator) {

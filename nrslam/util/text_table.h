@@ -21,6 +21,9 @@ class TextTable {
 
 // Fixed-point text of a number: FormatFixed(3.14159, 2) == "3.14".
 std::string FormatFixed(double value, int decimals);
+// A duration as a person reads it, rounded to what matters at its size: "42 s", "6 min",
+// "1 h 20 min".
+std::string FormatDuration(double seconds);
 // The items with `separator` between them: Join({"a", "b"}, ", ") == "a, b".
 std::string Join(const std::vector<std::string>& items, const std::string& separator);
 
