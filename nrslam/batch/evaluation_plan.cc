@@ -1,7 +1,6 @@
 #include "nrslam/batch/evaluation_plan.h"
 
 #include <algorithm>
-#include <chrono>
 #include <fstream>
 #include <iomanip>
 #include <optional>
@@ -370,17 +369,19 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
     progress(std::to_string(superseded) + " run(s) in the output folder had other options, another sequence, changed estimates or other code: run again");
   }
   size_t finished = 0;
-  const auto started = std::chrono::steady_clock::now();
+  double run_seconds = 0;
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const RunJob& run = plan.runs[run_index[k]];
     const std::string name = run.sequence + (run.label.empty() ? "" : " [" + run.label + "]");
     const std::string counter = "[" + std::to_string(++finished) + "/" + std::to_string(runs.size()) + "] ";
+    run_seconds += outcome.wall_seconds;
     if (outcome.ok() && RunIsFinished(run)) {
-      // The batch's pace so far, over the runs left: a sweep of hours says when it will end.
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      // The runs left at the mean time of those finished, `jobs` at a time: a sweep of hours
+      // says when it will end.
       const size_t left = runs.size() - finished;
+      const double estimate = run_seconds / finished * left / std::min<size_t>(left, std::max(1, jobs));
       progress(counter + name + " done in " + FormatDuration(outcome.wall_seconds) +
-               (left == 0 ? "" : "; about " + FormatDuration(elapsed / finished * left) + " left"));
+               (left == 0 ? "" : "; about " + FormatDuration(estimate) + " left"));
       return;
     }
     const std::string why = LastLine(runs[k].log);
