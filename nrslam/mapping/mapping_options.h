@@ -165,7 +165,9 @@ struct MappingOptions {
   // points of deformable triangulation, whose depth along a short-baseline ray is weak, are moved
   // along their ray to log r = w·log r_shading + (1 − w)·log r, the brightness calibrated on the
   // frame's tracked points. Rigid triangulation passed its rigidity and parallax gates and is
-  // left alone. 0 = off (the paper).
+  // left alone. At 1 it holds a deforming colon's map scale over 1000 frames, where without it
+  // the scale collapses; it costs the still scene and lap-lobes (README, "Long runs").
+  // 0 = off (the paper).
   double new_point_shading_weight = 0;
   void Check() const;
 };
