@@ -130,15 +130,12 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
   EvaluationPlan plan;
   // A point given twice would be two runs writing into one folder at once; an option swept
   // twice would leave one of its sweeps without effect.
-  for (size_t i = 0; i < sweeps.size(); ++i) {
-    for (size_t j = 0; j < i; ++j) {
-      if (sweeps[j].path == sweeps[i].path) throw Error("--sweep: " + sweeps[i].path + " is swept twice");
-    }
-    for (size_t v = 0; v < sweeps[i].values.size(); ++v) {
-      if (std::find(sweeps[i].values.begin(), sweeps[i].values.begin() + v, sweeps[i].values[v]) !=
-          sweeps[i].values.begin() + v) {
-        throw Error("--sweep " + sweeps[i].path + ": value " + sweeps[i].values[v] + " is given twice");
-      }
+  std::set<std::string> swept;
+  for (const Sweep& sweep : sweeps) {
+    if (!swept.insert(sweep.path).second) throw Error("--sweep: " + sweep.path + " is swept twice");
+    std::set<std::string> values;
+    for (const std::string& value : sweep.values) {
+      if (!values.insert(value).second) throw Error("--sweep " + sweep.path + ": value " + value + " is given twice");
     }
   }
   // The grid of sweep points, each a list of "path=value".
@@ -307,10 +304,14 @@ void CheckRunProgramCode(const std::filesystem::path& run_program) {
 
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
                  const std::function<void(const std::string&)>& progress, double run_timeout_seconds) {
-  if (std::any_of(plan.runs.begin(), plan.runs.end(),
-                  [](const RunJob& run) { return !run.is_external() && !RunIsFinished(run); })) {
-    CheckRunProgramCode(programs.run);  // before anything is rendered or removed
+  // Each run's config.json is read once, here.
+  std::vector<bool> finished_before(plan.runs.size());
+  bool runs_ours = false;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    finished_before[i] = RunIsFinished(plan.runs[i]);
+    runs_ours = runs_ours || (!finished_before[i] && !plan.runs[i].is_external());
   }
+  if (runs_ours) CheckRunProgramCode(programs.run);  // before anything is rendered or removed
   // Sequences first: several runs may share one.
   std::vector<Command> prepares;
   std::vector<size_t> prepare_index;
@@ -345,7 +346,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   size_t skipped = 0, superseded = 0;
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     const RunJob& run = plan.runs[i];
-    if (RunIsFinished(run)) {
+    if (finished_before[i]) {
       ++skipped;
       continue;
     }
