@@ -1,6 +1,7 @@
 // Batch evaluation: manifests and their validation, a batch that survives a broken sequence,
 // resumed sweeps, the baseline check, and jobs emitted for GNU parallel then merged.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -12,6 +13,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/manifest.h"
@@ -24,6 +26,7 @@
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder_lock.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
 #include "temp_folder.h"
@@ -1368,6 +1371,91 @@ TEST(BatchEvaluation, EmittedJobsRunByGnuParallelThenMerged) {
     EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
   }
   EXPECT_EQ(cache_entries, 1);
+  std::filesystem::remove_all(folder);
+}
+
+// Two evaluations that share a cache (as the cache is meant to be shared) and start at once both
+// render the sequences they lack: each into a folder of its own, the first to finish moving its
+// render into place. Here in two threads of one process, which must not take each other's
+// children either. What an interrupted evaluation left behind is removed; a live one's is not.
+TEST(BatchEvaluation, EvaluationsSharingACacheRenderTheSameSequencesAtOnce) {
+  const auto folder = UniqueTempFolder("batch_shared_cache");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({
+    "defaults": {"init": "depth", "simulate": )") + kTinySimulate + R"(},
+    "sequences": [{"name": "a", "preset": "sim-1"}, {"name": "b", "preset": "sim-2"}]})"));
+  const EvaluationPlan first = PlanEvaluation(manifest, {}, {}, folder / "first", folder / "cache");
+  const EvaluationPlan second = PlanEvaluation(manifest, {}, {}, folder / "second", folder / "cache");
+  ASSERT_EQ(first.prepares.size(), 2u);
+  char host[256] = {};
+  ::gethostname(host, sizeof(host) - 1);
+  const std::string sequence = first.prepares[0].folder.string();
+  const std::filesystem::path abandoned = sequence + ".partial." + host + "-999999999-0";  // beyond any pid
+  const std::filesystem::path live = sequence + ".partial." + host + "-1-0";               // init's
+  WriteFile(abandoned / "rgb" / "000000.png", "half");
+  WriteFile(abandoned.string() + ".log", "interrupted");
+  WriteFile(live / "sequence.json", "{}");
+
+  // The renderer, slowed down so that both evaluations start each render before either ends.
+  const std::filesystem::path slow = WriteFile(folder / "slow_simulate.sh", "#!/bin/sh\nsleep 2\nexec " +
+                                               kPrograms.simulate.string() + " \"$@\"\n");
+  std::filesystem::permissions(slow, std::filesystem::perms::owner_all);
+  const Programs programs{slow, kPrograms.run, kPrograms.import, kPrograms.eval};
+  std::vector<std::string> first_lines, second_lines;
+  std::thread other([&] { ExecutePlan(second, programs, 2, [&](const std::string& l) { second_lines.push_back(l); }); });
+  ExecutePlan(first, programs, 2, [&](const std::string& l) { first_lines.push_back(l); });
+  other.join();
+  // Both rendered both sequences: neither waited for the other.
+  const auto renders = [](const std::vector<std::string>& lines) {
+    return std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("rendered ", 0) == 0; });
+  };
+  EXPECT_EQ(renders(first_lines), 2) << ::testing::PrintToString(first_lines);
+  EXPECT_EQ(renders(second_lines), 2) << ::testing::PrintToString(second_lines);
+  const std::vector<RunResult> a = CollectResults(first), b = CollectResults(second);
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    ASSERT_EQ(a[i].status, "ok") << a[i].error << "\n" << ::testing::PrintToString(first_lines);
+    ASSERT_EQ(b[i].status, "ok") << b[i].error << "\n" << ::testing::PrintToString(second_lines);
+    EXPECT_EQ(a[i].frames_tracked, 8);
+    EXPECT_DOUBLE_EQ(a[i].rmse_mm, b[i].rmse_mm);  // the same complete sequence, whoever rendered it
+  }
+  std::set<std::string> cache;
+  for (const auto& entry : std::filesystem::directory_iterator(folder / "cache")) {
+    cache.insert(entry.path().filename().string());
+  }
+  const std::string live_name = live.filename().string();
+  const std::set<std::string> expected = {first.prepares[0].folder.filename().string(),
+                                          first.prepares[0].folder.filename().string() + ".log",
+                                          first.prepares[1].folder.filename().string(),
+                                          first.prepares[1].folder.filename().string() + ".log", live_name};
+  EXPECT_EQ(cache, expected);
+  std::filesystem::remove_all(folder);
+}
+
+TEST(BatchEvaluation, TwoEvaluationsIntoOneFolderAreRefused) {
+  const auto folder = UniqueTempFolder("batch_locked");
+  const std::filesystem::path manifest = WriteFile(folder / "m.json", std::string(R"({
+    "defaults": {"init": "depth", "simulate": )") + kTinySimulate + R"(},
+    "sequences": [{"name": "a", "preset": "sim-1"}]})");
+  const std::string evaluation = std::string(NRSLAM_TOOLS_DIR) + "/nrslam_eval " + manifest.string() + " --out " +
+                                 (folder / "out").string() + " --cache " + (folder / "cache").string() + " > " +
+                                 (folder / "log.txt").string() + " 2>&1";
+  {
+    const FolderLock running(folder / "out", "an evaluation still running");
+    EXPECT_THROW(FolderLock(folder / "out", "a second one"), Error);
+    EXPECT_NE(std::system(evaluation.c_str()), 0);
+    std::ifstream log(folder / "log.txt");
+    const std::string text((std::istreambuf_iterator<char>(log)), {});
+    EXPECT_NE(text.find("is in use by another process (an evaluation still running, pid " + std::to_string(::getpid()) +
+                        ")"),
+              std::string::npos)
+        << text;
+    EXPECT_FALSE(std::filesystem::exists(folder / "out" / "runs"));  // nothing ran
+    EXPECT_FALSE(std::filesystem::exists(folder / "cache"));         // nothing rendered
+  }
+  // The lock ends with its holder.
+  EXPECT_EQ(std::system(evaluation.c_str()), 0);
+  EXPECT_EQ(ReadResults(folder / "out").at(0).status, "ok");
   std::filesystem::remove_all(folder);
 }
 

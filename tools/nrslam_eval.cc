@@ -24,6 +24,7 @@
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder_lock.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
@@ -190,6 +191,7 @@ int main(int argc, char** argv) {
       // Runs of the same plan executed elsewhere: gather their run folders under --out.
       const nrslam::Manifest manifest = LoadChosen(merge_manifest, only, seeds);
       nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
+      const nrslam::FolderLock lock(out, "nrslam_eval merge " + merge_manifest);
       for (nrslam::RunJob& run : plan.runs) {
         for (const std::string& folder : merge_folders) {
           const std::filesystem::path candidate =
@@ -221,6 +223,7 @@ int main(int argc, char** argv) {
                 << nrslam::ShellLine(merge_command) << '\n';
       return 0;
     }
+    const nrslam::FolderLock lock(out, "nrslam_eval " + manifest_path);
     std::cerr << manifest.sequences.size() << " sequence(s), " << plan.runs.size() << " run(s), " << jobs
               << " at a time; output in " << out << '\n';
     // The runs' KLT is OpenMP-parallel, and libgomp's idle workers spin after every parallel

@@ -1,6 +1,11 @@
 #include "nrslam/batch/evaluation_plan.h"
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <fstream>
 #include <iomanip>
 #include <optional>
@@ -239,6 +244,39 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
 
 namespace {
 
+std::string HostName() {
+  char host[256] = {};
+  ::gethostname(host, sizeof(host) - 1);
+  return host;
+}
+
+// Where a sequence is prepared before it is moved into place: <folder>.partial.<host>-<pid>-<n>.
+// Evaluations that share a cache may prepare the same sequence at once; each writes only into a
+// folder of its own.
+std::filesystem::path PartialFolder(const std::filesystem::path& folder) {
+  static std::atomic<int> count{0};
+  return folder.string() + ".partial." + HostName() + "-" + std::to_string(::getpid()) + "-" +
+         std::to_string(count++);
+}
+
+// Removes the partial folders (and their logs) that interrupted evaluations on this machine
+// left behind: those whose process is gone. A cache shared between machines keeps the others'.
+void RemoveAbandonedPartials(const std::filesystem::path& folder) {
+  const std::string prefix = folder.filename().string() + ".partial." + HostName() + "-";
+  std::error_code unreadable;
+  for (const auto& entry : std::filesystem::directory_iterator(folder.parent_path(), unreadable)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const size_t end = name.find_first_not_of("0123456789", prefix.size());
+    if (end == prefix.size() || end == std::string::npos) continue;
+    if (::kill(static_cast<pid_t>(std::stol(name.substr(prefix.size(), end - prefix.size()))), 0) != 0 &&
+        errno == ESRCH) {
+      std::error_code ignored;
+      std::filesystem::remove_all(entry.path(), ignored);
+    }
+  }
+}
+
 const std::filesystem::path& ProgramOf(const RunJob& run, const Programs& programs) {
   return run.is_external() ? programs.eval : programs.run;
 }
@@ -315,28 +353,39 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   // Sequences first: several runs may share one.
   std::vector<Command> prepares;
   std::vector<size_t> prepare_index;
+  std::vector<std::filesystem::path> partials;
   for (size_t i = 0; i < plan.prepares.size(); ++i) {
     const PrepareJob& prepare = plan.prepares[i];
     if (std::filesystem::exists(prepare.folder)) continue;
     std::filesystem::create_directories(prepare.folder.parent_path());
-    std::filesystem::remove_all(prepare.folder.string() + ".partial");
-    Command command{PrepareCommand(prepare, programs), prepare.folder.string() + ".log"};
-    command.argv.insert(command.argv.end(), {"--out", prepare.folder.string() + ".partial"});
+    RemoveAbandonedPartials(prepare.folder);
+    const std::filesystem::path partial = PartialFolder(prepare.folder);
+    Command command{PrepareCommand(prepare, programs), partial.string() + ".log"};
+    command.argv.insert(command.argv.end(), {"--out", partial.string()});
     prepares.push_back(command);
     prepare_index.push_back(i);
+    partials.push_back(partial);
   }
   std::vector<std::string> prepare_errors(plan.prepares.size());
   RunCommands(prepares, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const PrepareJob& prepare = plan.prepares[prepare_index[k]];
+    const std::filesystem::path& partial = partials[k];
+    const std::string why = LastLine(prepares[k].log);
+    std::error_code not_moved;
+    if (outcome.ok()) std::filesystem::rename(partial, prepare.folder, not_moved);
+    // Another evaluation that prepared the same sequence first made the same files.
+    const bool ready = outcome.ok() && (!not_moved || std::filesystem::exists(prepare.folder));
+    std::error_code ignored;
+    std::filesystem::rename(prepares[k].log, prepare.folder.string() + ".log", ignored);
+    std::filesystem::remove_all(partial, ignored);
     const std::string verb = prepare.import ? "imported " : "rendered ";
-    if (outcome.ok()) {
-      std::filesystem::rename(prepare.folder.string() + ".partial", prepare.folder);
+    if (ready) {
       progress(verb + prepare.folder.filename().string());
     } else {
-      const std::string why = LastLine(prepares[k].log);
+      const std::string how = outcome.ok() ? "its folder could not be moved into place: " + not_moved.message()
+                                           : outcome.Describe();
       prepare_errors[prepare_index[k]] = (prepare.import ? "importing " : "rendering ") + prepare.description +
-                                         " failed (" + outcome.Describe() + ")" + (why.empty() ? "" : ": " + why);
-      std::filesystem::remove_all(prepare.folder.string() + ".partial");
+                                         " failed (" + how + ")" + (why.empty() ? "" : ": " + why);
       progress(prepare_errors[prepare_index[k]]);
     }
   });

@@ -96,40 +96,37 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
       ++next;
     }
     if (running.empty()) continue;
-    bool any_deadline = false;
-    for (const auto& [pid, child] : running) any_deadline |= child.deadline != Clock::time_point::max();
-    int status = 0;
-    rusage usage{};
-    // With a deadline to watch, poll (every 20 ms) instead of blocking until a child ends.
-    const pid_t pid = wait4(-1, &status, any_deadline ? WNOHANG : 0, &usage);
-    if (pid == 0) {
-      const Clock::time_point now = Clock::now();
-      for (auto& [child_pid, child] : running) {
-        ProcessOutcome& outcome = outcomes[child.index];
-        if (now < child.deadline || outcome.timed_out_after_seconds > 0) continue;
-        outcome.timed_out_after_seconds = commands[child.index].timeout_seconds;
-        kill(child_pid, SIGKILL);  // reaped by waitpid like any other ending
+    // Each child is reaped by its pid, never by wait(-1): the process may have other children
+    // (another thread's batch, a caller's own), whose endings are not this call's to collect.
+    bool any_ended = false;
+    const Clock::time_point now = Clock::now();
+    for (auto it = running.begin(); it != running.end();) {
+      const auto [pid, child] = *it;
+      ProcessOutcome& outcome = outcomes[child.index];
+      int status = 0;
+      rusage usage{};
+      const pid_t ended = wait4(pid, &status, WNOHANG, &usage);
+      if (ended == 0 || (ended < 0 && errno == EINTR)) {
+        if (now >= child.deadline && outcome.timed_out_after_seconds == 0) {
+          outcome.timed_out_after_seconds = commands[child.index].timeout_seconds;
+          kill(pid, SIGKILL);  // reaped like any other ending
+        }
+        ++it;
+        continue;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      continue;
+      if (ended < 0) {
+        outcome.error = "lost track of the child process";
+      } else {
+        if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
+        if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
+        outcome.peak_memory_mb = MaxResidentMb(usage);
+      }
+      outcome.wall_seconds = std::chrono::duration<double>(now - child.started).count();
+      it = running.erase(it);
+      any_ended = true;
+      if (done) done(child.index, outcome);
     }
-    if (pid < 0) {
-      if (errno == EINTR) continue;
-      // No children left to wait for although we think some run: record and stop waiting.
-      for (const auto& [lost_pid, child] : running) outcomes[child.index].error = "lost track of the child process";
-      running.clear();
-      continue;
-    }
-    const auto found = running.find(pid);
-    if (found == running.end()) continue;
-    const size_t index = found->second.index;
-    ProcessOutcome& outcome = outcomes[index];
-    if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
-    if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
-    outcome.peak_memory_mb = MaxResidentMb(usage);
-    outcome.wall_seconds = std::chrono::duration<double>(Clock::now() - found->second.started).count();
-    running.erase(found);
-    if (done) done(index, outcome);
+    if (!any_ended) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   return outcomes;
 }

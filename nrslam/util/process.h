@@ -33,7 +33,8 @@ struct ProcessOutcome {
 };
 
 // Runs the commands, at most `jobs` at once, in order of index; `done` is called (on this
-// thread) as each one finishes. Never throws for a child's failure: that is its outcome.
+// thread) as each one finishes. Never throws for a child's failure: that is its outcome. It
+// collects only its own children, so calls in several threads at once do not mix them up.
 std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
                                         const std::function<void(size_t index, const ProcessOutcome&)>& done = {});
 

@@ -1,0 +1,27 @@
+// util: one process at a time writing into a folder.
+//
+// Two evaluations started into the same output folder (a sweep launched twice, a resume while
+// the first still runs) would run the same runs into the same run folders at once and leave
+// results that mix both. The lock is advisory (flock on <folder>/.lock): the kernel drops it
+// when its holder ends, however it ends, so an interrupted evaluation never leaves it stale.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace nrslam {
+
+class FolderLock {
+ public:
+  // Takes the lock on `folder` (created if missing) for `holder`, a description such as
+  // "nrslam_eval data_manifests/ci-sim.json". Throws Error naming the process that holds it.
+  FolderLock(const std::filesystem::path& folder, const std::string& holder);
+  ~FolderLock();
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int descriptor_ = -1;
+};
+
+}  // namespace nrslam
