@@ -1447,13 +1447,20 @@ TEST(BatchEvaluation, TwoEvaluationsIntoOneFolderAreRefused) {
     std::ifstream log(folder / "log.txt");
     const std::string text((std::istreambuf_iterator<char>(log)), {});
     EXPECT_NE(text.find("is in use by another process (an evaluation still running, pid " + std::to_string(::getpid()) +
-                        ")"),
+                        ", or a process it started)"),
               std::string::npos)
         << text;
     EXPECT_FALSE(std::filesystem::exists(folder / "out" / "runs"));  // nothing ran
     EXPECT_FALSE(std::filesystem::exists(folder / "cache"));         // nothing rendered
   }
-  // The lock ends with its holder.
+  // A child of the holder keeps it (a run goes on writing after its evaluation was killed).
+  {
+    const FolderLock parent(folder / "out", "an evaluation killed later");
+    ASSERT_EQ(std::system("sleep 3 &"), 0);
+  }
+  EXPECT_THROW(FolderLock(folder / "out", "too soon"), Error);
+  std::this_thread::sleep_for(std::chrono::milliseconds(3500));
+  // The lock ends with its holder and its children.
   EXPECT_EQ(std::system(evaluation.c_str()), 0);
   EXPECT_EQ(ReadResults(folder / "out").at(0).status, "ok");
   std::filesystem::remove_all(folder);

@@ -1,6 +1,5 @@
 #include "nrslam/mapping/monocular_initialiser.h"
 
-
 #include <algorithm>
 #include <cmath>
 #include <deque>

@@ -16,7 +16,9 @@ namespace nrslam {
 FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& holder) {
   std::filesystem::create_directories(folder);
   const std::filesystem::path path = folder / ".lock";
-  descriptor_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Not close-on-exec: child processes share the lock, so that runs an evaluation started hold
+  // the folder until they end even when the evaluation itself was killed.
+  descriptor_ = ::open(path.c_str(), O_RDWR | O_CREAT, 0644);
   if (descriptor_ < 0) throw Error("cannot open " + path.string() + ": " + std::strerror(errno));
   if (::flock(descriptor_, LOCK_EX | LOCK_NB) != 0) {
     const int reason = errno;
@@ -26,7 +28,7 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& h
     std::ifstream file(path);
     const std::string other((std::istreambuf_iterator<char>(file)), {});
     throw Error(folder.string() + " is in use by another process (" + (other.empty() ? "unknown" : other) +
-                "); wait for it to end, or give another output folder");
+                ", or a process it started); wait for it to end, or give another output folder");
   }
   // Who holds it, for the message of the next one to try; the lock holds even if this fails.
   const std::string text = holder + ", pid " + std::to_string(::getpid());
