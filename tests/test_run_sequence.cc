@@ -359,6 +359,28 @@ TEST_F(RunSequenceTest, SavedConfigRepeatsTheRun) {
   EXPECT_EQ(text(*base_ / "repeated" / "trajectory.tum"), text(*base_ / "run" / "trajectory.tum"));
 }
 
+// A run into the folder of an earlier, longer run leaves nothing of that run behind (a stale
+// summary.json or depth map would pass for the new run's), but keeps files of the user's own.
+TEST_F(RunSequenceTest, ARunIntoAnEarlierRunsFolderReplacesItsOutput) {
+  const fs::path reused = *base_ / "reused";
+  fs::remove_all(reused);
+  fs::copy(*base_ / "run", reused, fs::copy_options::recursive);
+  std::ofstream(reused / "notes.txt") << "mine";
+  ASSERT_TRUE(fs::exists(reused / "depth" / "000039.png"));
+  SystemOptions shorter = TrackingExperiment();
+  shorter.run.last_frame = 5;
+  const RunSummary summary = RunSequence(*base_ / "sequence", shorter, reused);
+  EXPECT_EQ(summary.frames_tracked, 5);
+  int depth_maps = 0;
+  for (const auto& entry : fs::directory_iterator(reused / "depth")) {
+    ++depth_maps;
+    EXPECT_LT(std::stoi(entry.path().stem().string()), 5) << entry.path();
+  }
+  EXPECT_EQ(depth_maps, 5);
+  EXPECT_EQ(SystemOptionsFromFile(reused / "config.json").run.last_frame, 5);
+  EXPECT_TRUE(fs::exists(reused / "notes.txt"));
+}
+
 // How far each map point moved in the world between the first and the last frame it was reported in.
 std::vector<double> PointMovementsMm(const fs::path& points_csv) {
   std::map<PointId, std::pair<Eigen::Vector3d, Eigen::Vector3d>> first_last;

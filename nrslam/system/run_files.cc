@@ -75,6 +75,13 @@ void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& fram
 RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::filesystem::path& sequence,
                                 const nlohmann::json& config) {
   std::error_code error;
+  // An earlier run's output in the same folder goes first, its summary before anything else: a
+  // run that stops early must not leave the last run's result beside its own configuration,
+  // nor a shorter run the longer run's depth maps.
+  for (const char* file : {"summary.json", "trajectory.tum", "map.ply", "run.log", "depth"}) {
+    std::filesystem::remove_all(out / file, error);
+    if (error) throw Error("cannot remove the earlier run's " + (out / file).string() + ": " + error.message());
+  }
   std::filesystem::create_directories(out / "depth", error);
   if (error) throw Error("cannot create " + out.string() + ": " + error.message());
   {

@@ -66,7 +66,8 @@ std::string DescribeStop(int init_frame, int stop_frame, const std::string& reas
 void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& frames,
                    const std::vector<TrajectorySegment>& maps, const EvaluationOptions& options);
 
-// A run folder begun: `out` and `out`/depth created, config.json written (the version, the
+// A run folder begun: an earlier run's files in `out` removed (summary.json first; other
+// files are left alone), `out` and `out`/depth created, config.json written (the version, the
 // sequence's absolute path, then `config`'s keys), points.csv and metrics.csv opened with
 // their headers. Throws Error if any of it cannot be written.
 struct RunFolderStreams {
