@@ -65,6 +65,36 @@ TEST_F(SequenceReaderTest, ValidSequenceReadsBack) {
   EXPECT_THROW(reader.ReadRgb(kFrames), Error);
 }
 
+// A new sequence is never written over an old one, whose frames past the new one's end (or
+// whose depth, when the new one has none) would be read as its own; adding to one is allowed.
+TEST_F(SequenceReaderTest, ANewSequenceIsNotWrittenOverAnOldOne) {
+  SequenceInfo shorter = info_;
+  shorter.frame_count = 5;
+  try {
+    SequenceWriter(folder_, shorter, false);
+    ADD_FAILURE() << "written over the old sequence";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("already holds a sequence"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(SequenceReader(folder_).frame_count(), kFrames);  // untouched
+  const SequenceWriter more(folder_, info_, true, SequenceWriter::Target::kExistingSequence);
+  more.WriteDepthMm(0, cv::Mat(30, 40, CV_32F, cv::Scalar(70.0)));
+  EXPECT_FLOAT_EQ(SequenceReader(folder_).ReadDepthMm(0).at<float>(0, 0), 70.0f);
+  // Removed, it leaves only what is not the sequence's; then a new one goes in.
+  std::ofstream(folder_ / "notes.txt") << "mine";
+  std::ofstream(folder_ / "mask.png") << "not a mask";
+  RewriteJson([](nlohmann::json& json) { json["mask"] = "mask.png"; });
+  RemoveSequence(folder_);
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(folder_)) left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"notes.txt"});
+  SequenceWriter(folder_, shorter, false).WriteRgb(0, cv::Mat(30, 40, CV_8UC3, cv::Scalar(1, 2, 3)));
+  RemoveSequence(folder_);
+  RemoveSequence(folder_);  // no sequence: nothing to do
+  EXPECT_TRUE(fs::exists(folder_ / "notes.txt"));
+  ASSERT_EQ(std::distance(fs::directory_iterator(folder_), fs::directory_iterator()), 1);
+}
+
 TEST_F(SequenceReaderTest, MissingFrameIsNamed) {
   fs::remove(folder_ / "rgb" / "000037.png");
   EXPECT_ERROR_MENTIONS("missing frame 37 in rgb/");

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "nrslam/io/sequence_writer.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/source_revision.h"
@@ -44,6 +45,9 @@ int main(int argc, char** argv) {
   app.add_option("--set", assignments, "set any option, e.g. --set deformation.amplitude_mm=5 (see --print-options)");
   app.add_flag("--print-options", print_options, "print the resolved options as JSON and exit");
   app.add_flag("--quiet", quiet, "no progress line");
+  bool overwrite = false;
+  app.add_flag("--overwrite", overwrite, "replace a sequence already in the output folder (its sequence.json, rgb/, "
+                                         "depth/, right/, groundtruth.tum and mask; other files stay)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -77,6 +81,7 @@ int main(int argc, char** argv) {
     for (const std::string& name : names) {
       const nrslam::SimOptions options = resolve(name);
       const std::filesystem::path folder = suite ? std::filesystem::path(out) / name : std::filesystem::path(out);
+      if (overwrite) nrslam::RemoveSequence(folder);
       const auto summary = nrslam::SimulateSequence(options, name, folder, [&](int done, int total, double ms) {
         if (!quiet) PrintProgress(name, done, total, ms);
       });

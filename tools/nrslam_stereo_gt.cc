@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
     nrslam::SequenceInfo info = sequence.info();
     info.provenance["depth"] = {{"generator", std::string("nrslam_stereo_gt ") + NRSLAM_VERSION},
                                 {"options", nrslam::Json(options)}};
-    const nrslam::SequenceWriter writer(folder, info, true);
+    const nrslam::SequenceWriter writer(folder, info, true, nrslam::SequenceWriter::Target::kExistingSequence);
     for (int i = 0; i < sequence.frame_count(); ++i) {
       writer.WriteDepthMm(i, nrslam::StereoDepthMm(sequence.ReadRgb(i), sequence.ReadRight(i), info.camera.fx(),
                                                    info.stereo->baseline_mm, options));

@@ -10,9 +10,30 @@
 namespace nrslam {
 namespace fs = std::filesystem;
 
-SequenceWriter::SequenceWriter(const fs::path& folder, const SequenceInfo& info, bool with_depth)
+void RemoveSequence(const fs::path& folder) {
+  if (!fs::exists(folder / "sequence.json")) return;
+  std::vector<fs::path> entries = {"rgb", "depth", "right", "groundtruth.tum"};
+  try {
+    const std::string mask = nlohmann::json::parse(std::ifstream(folder / "sequence.json")).value("mask", "");
+    // Only a mask inside the folder: the file names no other place to delete.
+    if (!mask.empty() && fs::path(mask).is_relative() && mask.find("..") == std::string::npos) entries.push_back(mask);
+  } catch (const nlohmann::json::exception&) {
+    // An unreadable sequence.json names no mask; the rest goes all the same.
+  }
+  entries.push_back("sequence.json");  // last: until then the folder still says what it holds
+  for (const fs::path& entry : entries) {
+    std::error_code error;
+    fs::remove_all(folder / entry, error);
+    if (error) throw Error("cannot remove " + (folder / entry).string() + ": " + error.message());
+  }
+}
+
+SequenceWriter::SequenceWriter(const fs::path& folder, const SequenceInfo& info, bool with_depth, Target target)
     : folder_(folder), info_(info) {
   info_.Check();
+  if (target == Target::kNewSequence && fs::exists(folder / "sequence.json")) {
+    throw Error(folder.string() + " already holds a sequence (sequence.json); remove it or write to another folder");
+  }
   std::error_code error;
   fs::create_directories(folder / "rgb", error);
   if (with_depth) fs::create_directories(folder / "depth", error);

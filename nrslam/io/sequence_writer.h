@@ -11,10 +11,21 @@
 
 namespace nrslam {
 
+// Removes the sequence in `folder` (sequence.json, rgb/, depth/, right/, groundtruth.tum and
+// its mask image), leaving any other file; nothing when the folder holds no sequence.json.
+// Throws Error when something cannot be removed.
+void RemoveSequence(const std::filesystem::path& folder);
+
 class SequenceWriter {
  public:
-  // Creates the folder layout; throws Error if the folder cannot be written.
-  SequenceWriter(const std::filesystem::path& folder, const SequenceInfo& info, bool with_depth);
+  // A new sequence, or more of an existing one (e.g. its depth from stereo).
+  enum class Target { kNewSequence, kExistingSequence };
+  // Creates the folder layout and writes sequence.json; throws Error if the folder cannot be
+  // written, or for a new sequence if it already holds one: written over, an earlier sequence
+  // would leave its frames past this one's end, or its depth when this one has none, to be read
+  // as this sequence's.
+  SequenceWriter(const std::filesystem::path& folder, const SequenceInfo& info, bool with_depth,
+                 Target target = Target::kNewSequence);
 
   void WriteRgb(int index, const cv::Mat& bgr) const;
   void WriteRight(int index, const cv::Mat& bgr) const;
