@@ -1,6 +1,7 @@
 // Batch evaluation: manifests and their validation, a batch that survives a broken sequence,
 // resumed sweeps, the baseline check, and jobs emitted for GNU parallel then merged.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -27,6 +28,7 @@
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/folder_lock.h"
+#include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
 #include "temp_folder.h"
@@ -1429,7 +1431,27 @@ TEST(BatchEvaluation, EvaluationsSharingACacheRenderTheSameSequencesAtOnce) {
                                           first.prepares[1].folder.filename().string(),
                                           first.prepares[1].folder.filename().string() + ".log", live_name};
   EXPECT_EQ(cache, expected);
+  // What was abandoned beside a sequence already there goes too, with nothing to run.
+  const std::filesystem::path late = first.prepares[1].folder.string() + ".partial." + host + "-999999999-3.log";
+  WriteFile(late, "interrupted");
+  ExecutePlan(first, programs, 2, [](const std::string&) {});
+  EXPECT_FALSE(std::filesystem::exists(late));
   std::filesystem::remove_all(folder);
+}
+
+// An evaluation killed before its parent reaped it is a zombie: ended, though kill(pid, 0)
+// still finds it. Its partial renders are abandoned all the same.
+TEST(Processes, AZombieIsNotRunning) {
+  EXPECT_TRUE(ProcessIsRunning(::getpid()));
+  EXPECT_FALSE(ProcessIsRunning(999999999));
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // it has exited, not been reaped
+  EXPECT_EQ(::kill(child, 0), 0);
+  EXPECT_FALSE(ProcessIsRunning(child));
+  ::waitpid(child, nullptr, 0);
+  EXPECT_FALSE(ProcessIsRunning(child));
 }
 
 TEST(BatchEvaluation, TwoEvaluationsIntoOneFolderAreRefused) {

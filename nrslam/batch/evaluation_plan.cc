@@ -1,11 +1,9 @@
 #include "nrslam/batch/evaluation_plan.h"
 
-#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <fstream>
 #include <iomanip>
 #include <optional>
@@ -269,8 +267,8 @@ void RemoveAbandonedPartials(const std::filesystem::path& folder) {
     if (name.rfind(prefix, 0) != 0) continue;
     const size_t end = name.find_first_not_of("0123456789", prefix.size());
     if (end == prefix.size() || end == std::string::npos) continue;
-    if (::kill(static_cast<pid_t>(std::stol(name.substr(prefix.size(), end - prefix.size()))), 0) != 0 &&
-        errno == ESRCH) {
+    const long long pid = end - prefix.size() > 9 ? -1 : std::stoll(name.substr(prefix.size(), end - prefix.size()));
+    if (!ProcessIsRunning(static_cast<int>(pid))) {
       std::error_code ignored;
       std::filesystem::remove_all(entry.path(), ignored);
     }
@@ -356,9 +354,9 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   std::vector<std::filesystem::path> partials;
   for (size_t i = 0; i < plan.prepares.size(); ++i) {
     const PrepareJob& prepare = plan.prepares[i];
+    RemoveAbandonedPartials(prepare.folder);
     if (std::filesystem::exists(prepare.folder)) continue;
     std::filesystem::create_directories(prepare.folder.parent_path());
-    RemoveAbandonedPartials(prepare.folder);
     const std::filesystem::path partial = PartialFolder(prepare.folder);
     Command command{PrepareCommand(prepare, programs), partial.string() + ".log"};
     command.argv.insert(command.argv.end(), {"--out", partial.string()});

@@ -145,6 +145,15 @@ std::optional<std::string> CommandOutput(const std::vector<std::string>& argv, d
   return output;
 }
 
+bool ProcessIsRunning(int pid) {
+  if (pid <= 0 || (kill(pid, 0) != 0 && errno == ESRCH)) return false;
+  // "pid (name) S ...": the state follows the last ')', as the name may hold any character.
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  const std::string line((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const size_t name_end = line.rfind(')');
+  return name_end == std::string::npos || name_end + 2 >= line.size() || line[name_end + 2] != 'Z';
+}
+
 std::string ShellLine(const std::vector<std::string>& argv) {
   std::string line;
   for (const std::string& argument : argv) {

@@ -43,6 +43,10 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
 // short queries such as a program's --version, not for runs.
 std::optional<std::string> CommandOutput(const std::vector<std::string>& argv, double timeout_seconds);
 
+// Whether a process of this machine is still running: false once it has ended, even while it
+// waits to be reaped (a zombie).
+bool ProcessIsRunning(int pid);
+
 // A command as one line a POSIX shell runs as is (every argument single-quoted as needed).
 std::string ShellLine(const std::vector<std::string>& argv);
 
