@@ -1317,7 +1317,7 @@ TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
   std::vector<std::string> lines;
   ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   ASSERT_EQ(lines.size(), 2u);
-  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options, another sequence, changed estimates or other code: run again");
+  EXPECT_EQ(lines[0], "1 run(s) in the output folder had other options, another or changed sequence, changed estimates or other code: run again");
   EXPECT_NE(lines[1].find("[1/1] s done"), std::string::npos) << lines[1];
   const Json config = ReadJsonFile(plain.runs[0].run_folder / "config.json");
   EXPECT_EQ(config.at("options").at("deformation").at("k"), Json(DeformationModelOptions{}.k));
@@ -1325,6 +1325,16 @@ TEST(BatchEvaluation, AnOutputFolderReusedWithOtherOptionsIsRunAgain) {
   lines.clear();
   ExecutePlan(plain, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   EXPECT_EQ(lines, std::vector<std::string>{"1 run(s) already finished, not run again"});
+  // The sequence's description edited in place (here its frame rate; a corrected calibration
+  // alike): its runs are run again.
+  const std::filesystem::path description = plain.runs[0].sequence_folder / "sequence.json";
+  const Json original = ReadJsonFile(description);
+  Json edited = original;
+  edited["fps"] = 25.0;
+  std::ofstream(description) << edited.dump();
+  EXPECT_FALSE(RunIsFinished(plain.runs[0]));
+  std::ofstream(description) << original.dump(2);  // the same description, written otherwise
+  EXPECT_TRUE(RunIsFinished(plain.runs[0]));
   // A run from another commit whose code is the same (a commit of the README alone) is reused...
   const Json as_written = ReadJsonFile(plain.runs[0].run_folder / "config.json");
   EXPECT_EQ(as_written.at("nrslam_revision"), SourceRevision());

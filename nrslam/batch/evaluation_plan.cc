@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "nrslam/io/sequence_info.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/process.h"
@@ -310,8 +311,12 @@ bool RunIsFinished(const RunJob& run) {
   if (!std::filesystem::exists(run.run_folder / "summary.json")) return false;
   try {
     const Json config = ReadJsonFile(run.run_folder / "config.json");
+    // The same folder holding another description (a calibration corrected, frames added) is
+    // another sequence.
     const bool same_sequence =
-        config.at("sequence").get<std::string>() == std::filesystem::absolute(run.sequence_folder).string();
+        config.at("sequence").get<std::string>() == std::filesystem::absolute(run.sequence_folder).string() &&
+        config.value("sequence_info", Json()) ==
+            Json(ReadJsonFile(run.sequence_folder / "sequence.json").get<SequenceInfo>());
     if (run.is_external()) return config.value("external", Json()) == run.external && same_sequence;
     // Parsed back through the options struct, so that a config written before an option
     // existed compares as that option's default.
@@ -414,7 +419,9 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   }
   if (skipped > 0) progress(std::to_string(skipped) + " run(s) already finished, not run again");
   if (superseded > 0) {
-    progress(std::to_string(superseded) + " run(s) in the output folder had other options, another sequence, changed estimates or other code: run again");
+    progress(std::to_string(superseded) +
+             " run(s) in the output folder had other options, another or changed sequence, changed estimates or "
+             "other code: run again");
   }
   size_t finished = 0;
   double run_seconds = 0;
