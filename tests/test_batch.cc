@@ -1269,6 +1269,34 @@ TEST(BatchEvaluation, ARunThatHangsIsKilledAtItsTimeoutAndRecorded) {
   std::filesystem::remove_all(folder);
 }
 
+// Stopped (nrslam_eval on SIGINT or SIGTERM): the runs going are ended, none more starts, and
+// none is recorded as failed, so the next evaluation runs them.
+TEST(BatchEvaluation, AStoppedBatchEndsItsRunsAndLeavesThemUnfinished) {
+  const auto folder = UniqueTempFolder("batch_stopped");
+  EvaluationPlan plan;
+  // Two runs going and one waiting when the stop comes (--version answers at once).
+  const std::filesystem::path sleeper =
+      StandInRunner(folder, "[ \"$1\" = --version ] && exit 1\nexec sleep 600\n", 3, &plan);
+  std::atomic<bool> stop{false};
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    stop = true;
+  });
+  std::vector<std::string> lines;
+  const auto start = std::chrono::steady_clock::now();
+  ExecutePlan(plan, Programs{kPrograms.simulate, sleeper, kPrograms.import, kPrograms.eval}, 2,
+              [&](const std::string& line) { lines.push_back(line); }, 0, &stop);
+  stopper.join();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 30.0);
+  EXPECT_EQ(lines, std::vector<std::string>{
+                       "3 run(s) interrupted and left unfinished: the next evaluation into this folder runs them"});
+  for (const RunJob& run : plan.runs) {
+    EXPECT_FALSE(std::filesystem::exists(run.run_folder / "failure.json")) << run.run_folder;
+    EXPECT_FALSE(RunIsFinished(run));
+  }
+  std::filesystem::remove_all(folder);
+}
+
 TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
   const auto folder = UniqueTempFolder("batch_resume");
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", std::string(R"({

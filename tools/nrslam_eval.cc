@@ -9,6 +9,8 @@
 // output as a run.
 #include <CLI/CLI.hpp>
 
+#include <atomic>
+#include <csignal>
 #include <fstream>
 #include <iostream>
 #include <thread>
@@ -100,6 +102,11 @@ int Compare(const std::filesystem::path& a, const std::filesystem::path& b) {
   table.Print(std::cout);
   return 0;
 }
+
+// Set on SIGINT and SIGTERM: the batch stops its runs and ends, and what finished is kept.
+std::atomic<bool> stop_requested{false};
+
+void RequestStop(int) { stop_requested = true; }
 
 }  // namespace
 
@@ -231,8 +238,17 @@ int main(int argc, char** argv) {
     // needs (two sim runs side by side: 10.3 / 10.0 fps spinning, 13.7 / 14.8 passive). The
     // children inherit this; a value the user set is kept.
     if (jobs > 1) setenv("OMP_WAIT_POLICY", "passive", /*overwrite=*/0);
+    struct sigaction on_stop {};
+    on_stop.sa_handler = RequestStop;
+    sigaction(SIGINT, &on_stop, nullptr);
+    sigaction(SIGTERM, &on_stop, nullptr);
     nrslam::ExecutePlan(
-        plan, programs, jobs, [](const std::string& line) { std::cerr << line << '\n'; }, run_timeout);
+        plan, programs, jobs, [](const std::string& line) { std::cerr << line << '\n'; }, run_timeout,
+        &stop_requested);
+    if (stop_requested) {
+      std::cerr << "nrslam_eval: interrupted; the runs that finished are kept, and the same command resumes\n";
+      return 130;
+    }
     return Finish(plan, out, check_baseline, write_baseline, tolerance);
   } catch (const std::exception& e) {
     std::cerr << "nrslam_eval: " << e.what() << '\n';

@@ -344,7 +344,9 @@ void CheckRunProgramCode(const std::filesystem::path& run_program) {
 }
 
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
-                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds) {
+                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds,
+                 const std::atomic<bool>* stop) {
+  const auto stopped = [stop] { return stop && *stop; };
   // Each run's config.json is read once, here.
   std::vector<bool> finished_before(plan.runs.size());
   bool runs_ours = false;
@@ -381,6 +383,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
     std::error_code ignored;
     std::filesystem::rename(prepares[k].log, prepare.folder.string() + ".log", ignored);
     std::filesystem::remove_all(partial, ignored);
+    if (outcome.interrupted) return;
     const std::string verb = prepare.import ? "imported " : "rendered ";
     if (ready) {
       progress(verb + prepare.folder.filename().string());
@@ -391,7 +394,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
                                          " failed (" + how + ")" + (why.empty() ? "" : ": " + why);
       progress(prepare_errors[prepare_index[k]]);
     }
-  });
+  }, stop);
 
   std::vector<Command> runs;
   std::vector<size_t> run_index;
@@ -423,7 +426,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
              " run(s) in the output folder had other options, another or changed sequence, changed estimates or "
              "other code: run again");
   }
-  size_t finished = 0;
+  size_t finished = 0, interrupted = 0;
   double run_seconds = 0;
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const RunJob& run = plan.runs[run_index[k]];
@@ -439,11 +442,19 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
                (left == 0 ? "" : "; about " + FormatDuration(estimate) + " left"));
       return;
     }
+    if (outcome.interrupted || stopped()) {
+      ++interrupted;  // not a failure of the run: it is left unfinished, for the next evaluation
+      return;
+    }
     const std::string why = LastLine(runs[k].log);
     const std::string how = outcome.ok() ? "exited with 0 but left no finished run" : outcome.Describe();
     WriteFailure(run, "run", how + (why.empty() ? "" : ": " + why));
     progress(counter + name + " FAILED (" + how + ")" + (why.empty() ? "" : ": " + why));
-  });
+  }, stop);
+  if (interrupted > 0) {
+    progress(std::to_string(interrupted) +
+             " run(s) interrupted and left unfinished: the next evaluation into this folder runs them");
+  }
 }
 
 }  // namespace nrslam

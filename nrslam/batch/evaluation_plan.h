@@ -2,6 +2,7 @@
 // one nrslam_run per (sequence, sweep point) — and running it with a few processes at a time.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -97,8 +98,12 @@ void CheckRunProgramCode(const std::filesystem::path& run_program);
 // (failure.json), never thrown; only an nrslam_run of other code throws, before anything
 // is run (CheckRunProgramCode). A run still going after `run_timeout_seconds` (wall clock;
 // 0: no limit) is killed and recorded as failed, so one sequence that hangs cannot stall a
-// batch; it is run again by the next evaluation into the same folder.
+// batch; it is run again by the next evaluation into the same folder. Once `*stop` is true
+// (nrslam_eval sets it on SIGINT and SIGTERM) nothing more starts, the running programs are
+// sent SIGTERM, and those runs are left unfinished without a failure: the next evaluation
+// into the same folder runs them.
 void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
-                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds = 0);
+                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds = 0,
+                 const std::atomic<bool>* stop = nullptr);
 
 }  // namespace nrslam

@@ -26,6 +26,7 @@ namespace nrslam {
 
 std::string ProcessOutcome::Describe() const {
   if (!error.empty()) return error;
+  if (interrupted) return "interrupted";
   if (timed_out_after_seconds > 0) {
     std::ostringstream text;
     text << "timed out after " << timed_out_after_seconds << " s (killed)";
@@ -69,7 +70,8 @@ pid_t Start(const Command& command, std::string* error) {
 }  // namespace
 
 std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
-                                        const std::function<void(size_t, const ProcessOutcome&)>& done) {
+                                        const std::function<void(size_t, const ProcessOutcome&)>& done,
+                                        const std::atomic<bool>* stop) {
   using Clock = std::chrono::steady_clock;
   struct Running {
     size_t index;
@@ -80,7 +82,19 @@ std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, in
   std::map<pid_t, Running> running;
   size_t next = 0;
   const size_t limit = static_cast<size_t>(std::max(1, jobs));
+  bool stopping = false;
   while (next < commands.size() || !running.empty()) {
+    if (stop && *stop && !stopping) {
+      stopping = true;
+      for (const auto& [pid, child] : running) {
+        outcomes[child.index].interrupted = true;
+        kill(pid, SIGTERM);  // reaped below like any other ending
+      }
+      for (; next < commands.size(); ++next) {
+        outcomes[next].interrupted = true;
+        if (done) done(next, outcomes[next]);
+      }
+    }
     while (next < commands.size() && running.size() < limit) {
       const pid_t pid = Start(commands[next], &outcomes[next].error);
       if (pid < 0) {

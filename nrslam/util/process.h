@@ -5,6 +5,7 @@
 // cores share nothing.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -24,19 +25,26 @@ struct ProcessOutcome {
   int signal = 0;      // when a signal ended it
   std::string error;   // when it could not be started
   double timed_out_after_seconds = 0;  // when it was killed for running past its timeout
+  bool interrupted = false;   // stopped (never started, or sent SIGTERM) because the batch was
   double peak_memory_mb = 0;  // the child's peak resident memory, once it has ended
   double wall_seconds = 0;    // how long it ran, from its start to its end (wall clock)
-  bool ok() const { return error.empty() && signal == 0 && exit_code == 0 && timed_out_after_seconds == 0; }
+  bool ok() const {
+    return error.empty() && signal == 0 && exit_code == 0 && timed_out_after_seconds == 0 && !interrupted;
+  }
   // "exit code 1", "killed by signal 9 (Killed) at a peak of 23112 MB", "timed out after 60 s
-  // (killed)", or the start error. The peak says whether a killed run was out of memory.
+  // (killed)", "interrupted", or the start error. The peak says whether a killed run was out
+  // of memory.
   std::string Describe() const;
 };
 
 // Runs the commands, at most `jobs` at once, in order of index; `done` is called (on this
 // thread) as each one finishes. Never throws for a child's failure: that is its outcome. It
 // collects only its own children, so calls in several threads at once do not mix them up.
+// Once `*stop` is true (e.g. set by a SIGTERM handler) no further command starts, those
+// running are sent SIGTERM and waited for, and every one of them is `interrupted`.
 std::vector<ProcessOutcome> RunCommands(const std::vector<Command>& commands, int jobs,
-                                        const std::function<void(size_t index, const ProcessOutcome&)>& done = {});
+                                        const std::function<void(size_t index, const ProcessOutcome&)>& done = {},
+                                        const std::atomic<bool>* stop = nullptr);
 
 // Runs a command to its end and returns what it wrote (stdout and stderr); nullopt when it
 // could not be started, did not exit with 0 or ran past the timeout (then it is killed). For
