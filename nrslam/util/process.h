@@ -25,7 +25,7 @@ struct ProcessOutcome {
   int signal = 0;      // when a signal ended it
   std::string error;   // when it could not be started
   double timed_out_after_seconds = 0;  // when it was killed for running past its timeout
-  bool interrupted = false;   // stopped (never started, or sent SIGTERM) because the batch was
+  bool interrupted = false;   // the batch was stopped: never started, or ended by SIGTERM
   double peak_memory_mb = 0;  // the child's peak resident memory, once it has ended
   double wall_seconds = 0;    // how long it ran, from its start to its end (wall clock)
   bool ok() const {
