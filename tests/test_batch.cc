@@ -1128,10 +1128,16 @@ TEST(BatchEvaluation, ImportedDatasetsRunAndAMissingOneIsReported) {
 // A runner that crashes (here: a stand-in that kills itself with SIGSEGV) or cannot be
 // started is a recorded failure of that run, with the reason; the batch finishes.
 // A script standing in for nrslam_run in `folder`, and a plan of `runs` runs for it to fail.
+// An executable shell script.
+std::filesystem::path WriteScript(const std::filesystem::path& file, const std::string& body) {
+  const std::filesystem::path script = WriteFile(file, "#!/bin/sh\n" + body);
+  std::filesystem::permissions(script, std::filesystem::perms::owner_all);
+  return script;
+}
+
 std::filesystem::path StandInRunner(const std::filesystem::path& folder, const std::string& script, int runs,
                                     EvaluationPlan* plan) {
-  const std::filesystem::path runner = WriteFile(folder / "runner.sh", "#!/bin/sh\n" + script);
-  std::filesystem::permissions(runner, std::filesystem::perms::owner_all);
+  const std::filesystem::path runner = WriteScript(folder / "runner.sh", script);
   WriteFile(folder / "seq" / "sequence.json", "{}");
   std::string sequences;
   for (int i = 0; i < runs; ++i) sequences += std::string(i ? "," : "") + R"({"name": "r)" + std::to_string(i) + R"(", "path": "seq"})";
@@ -1436,9 +1442,8 @@ TEST(BatchEvaluation, EvaluationsSharingACacheRenderTheSameSequencesAtOnce) {
   WriteFile(live / "sequence.json", "{}");
 
   // The renderer, slowed down so that both evaluations start each render before either ends.
-  const std::filesystem::path slow = WriteFile(folder / "slow_simulate.sh", "#!/bin/sh\nsleep 2\nexec " +
-                                               kPrograms.simulate.string() + " \"$@\"\n");
-  std::filesystem::permissions(slow, std::filesystem::perms::owner_all);
+  const std::filesystem::path slow =
+      WriteScript(folder / "slow_simulate.sh", "sleep 2\nexec " + kPrograms.simulate.string() + " \"$@\"\n");
   const Programs programs{slow, kPrograms.run, kPrograms.import, kPrograms.eval};
   std::vector<std::string> first_lines, second_lines;
   std::thread other([&] { ExecutePlan(second, programs, 2, [&](const std::string& l) { second_lines.push_back(l); }); });

@@ -258,18 +258,19 @@ std::filesystem::path PartialFolder(const std::filesystem::path& folder) {
          std::to_string(count++);
 }
 
-// Removes the partial folders (and their logs) that interrupted evaluations on this machine
-// left behind: those whose process is gone. A cache shared between machines keeps the others'.
-void RemoveAbandonedPartials(const std::filesystem::path& folder) {
-  const std::string prefix = folder.filename().string() + ".partial." + HostName() + "-";
+// Removes the partial folders (and their logs) in `cache` that interrupted evaluations on this
+// machine left behind: those whose process is gone. A cache shared between machines keeps the
+// others'.
+void RemoveAbandonedPartials(const std::filesystem::path& cache) {
+  const std::string marker = ".partial." + HostName() + "-";
   std::error_code unreadable;
-  for (const auto& entry : std::filesystem::directory_iterator(folder.parent_path(), unreadable)) {
+  for (const auto& entry : std::filesystem::directory_iterator(cache, unreadable)) {
     const std::string name = entry.path().filename().string();
-    if (name.rfind(prefix, 0) != 0) continue;
-    const size_t end = name.find_first_not_of("0123456789", prefix.size());
-    if (end == prefix.size() || end == std::string::npos) continue;
-    const long long pid = end - prefix.size() > 9 ? -1 : std::stoll(name.substr(prefix.size(), end - prefix.size()));
-    if (!ProcessIsRunning(static_cast<int>(pid))) {
+    const size_t at = name.find(marker);
+    if (at == std::string::npos) continue;
+    const std::string pid = name.substr(at + marker.size(), name.find('-', at + marker.size()) - at - marker.size());
+    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (!ProcessIsRunning(std::stoi(pid))) {
       std::error_code ignored;
       std::filesystem::remove_all(entry.path(), ignored);
     }
@@ -359,9 +360,11 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   std::vector<Command> prepares;
   std::vector<size_t> prepare_index;
   std::vector<std::filesystem::path> partials;
+  std::set<std::filesystem::path> caches;
+  for (const PrepareJob& prepare : plan.prepares) caches.insert(prepare.folder.parent_path());
+  for (const std::filesystem::path& cache : caches) RemoveAbandonedPartials(cache);
   for (size_t i = 0; i < plan.prepares.size(); ++i) {
     const PrepareJob& prepare = plan.prepares[i];
-    RemoveAbandonedPartials(prepare.folder);
     if (std::filesystem::exists(prepare.folder)) continue;
     std::filesystem::create_directories(prepare.folder.parent_path());
     const std::filesystem::path partial = PartialFolder(prepare.folder);

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -14,10 +15,10 @@ void RemoveSequence(const fs::path& folder) {
   if (!fs::exists(folder / "sequence.json")) return;
   std::vector<fs::path> entries = {"rgb", "depth", "right", "groundtruth.tum"};
   try {
-    const std::string mask = nlohmann::json::parse(std::ifstream(folder / "sequence.json")).value("mask", "");
+    const std::string mask = ReadJsonFile(folder / "sequence.json").value("mask", "");
     // Only a mask inside the folder: the file names no other place to delete.
     if (!mask.empty() && fs::path(mask).is_relative() && mask.find("..") == std::string::npos) entries.push_back(mask);
-  } catch (const nlohmann::json::exception&) {
+  } catch (const std::exception&) {
     // An unreadable sequence.json names no mask; the rest goes all the same.
   }
   entries.push_back("sequence.json");  // last: until then the folder still says what it holds
