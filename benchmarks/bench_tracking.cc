@@ -11,6 +11,7 @@
 
 #include "bench_options.h"
 #include "nrslam/sim/renderer.h"
+#include "nrslam/sim/sim_options.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/source_revision.h"
 
