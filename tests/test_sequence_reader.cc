@@ -83,6 +83,8 @@ TEST_F(SequenceReaderTest, ANewSequenceIsNotWrittenOverAnOldOne) {
   // Removed, it leaves only what is not the sequence's; then a new one goes in.
   std::ofstream(folder_ / "notes.txt") << "mine";
   std::ofstream(folder_ / "mask.png") << "not a mask";
+  fs::create_directories(folder_ / "masks");  // per-frame masks, which the reader would read
+  std::ofstream(folder_ / "masks" / FrameFileName(0)) << "old";
   RewriteJson([](nlohmann::json& json) { json["mask"] = "mask.png"; });
   RemoveSequence(folder_);
   std::vector<std::string> left;

@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "no progress line");
   bool overwrite = false;
   app.add_flag("--overwrite", overwrite, "replace a sequence already in the output folder (its sequence.json, rgb/, "
-                                         "depth/, right/, groundtruth.tum and mask; other files stay)");
+                                         "depth/, right/, masks/, groundtruth.tum and mask; other files stay)");
   CLI11_PARSE(app, argc, argv);
 
   try {

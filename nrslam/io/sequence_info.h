@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <optional>
 #include <string>
 
@@ -30,6 +31,10 @@ struct SequenceInfo {
 
 void to_json(nlohmann::json& j, const SequenceInfo& info);
 void from_json(const nlohmann::json& j, SequenceInfo& info);
+
+// What a sequence folder holds besides sequence.json and the mask it names: its per-frame PNG
+// folders (rgb/ always; depth/, right/ and masks/ when present) and its trajectory.
+inline constexpr std::array<const char*, 5> kSequenceEntries = {"rgb", "depth", "right", "masks", "groundtruth.tum"};
 
 // "000037.png": the file name of frame `index` in every per-frame folder.
 std::string FrameFileName(int index);

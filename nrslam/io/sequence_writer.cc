@@ -13,7 +13,7 @@ namespace fs = std::filesystem;
 
 void RemoveSequence(const fs::path& folder) {
   if (!fs::exists(folder / "sequence.json")) return;
-  std::vector<fs::path> entries = {"rgb", "depth", "right", "groundtruth.tum"};
+  std::vector<fs::path> entries(kSequenceEntries.begin(), kSequenceEntries.end());
   try {
     const std::string mask = ReadJsonFile(folder / "sequence.json").value("mask", "");
     // Only a mask inside the folder: the file names no other place to delete.

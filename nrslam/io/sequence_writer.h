@@ -11,8 +11,8 @@
 
 namespace nrslam {
 
-// Removes the sequence in `folder` (sequence.json, rgb/, depth/, right/, groundtruth.tum and
-// its mask image), leaving any other file; nothing when the folder holds no sequence.json.
+// Removes the sequence in `folder` (sequence.json, its mask image and kSequenceEntries),
+// leaving any other file; nothing when the folder holds no sequence.json.
 // Throws Error when something cannot be removed.
 void RemoveSequence(const std::filesystem::path& folder);
 
