@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bench_options.h"
+#include "nrslam/io/depth_encoding.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/tracking/tracker.h"
@@ -32,15 +33,20 @@ int main(int argc, char** argv) {
   std::printf("%-9s %-10s %7s %7s %8s %8s %9s %8s %9s %8s %8s\n", "preset", "mode", "tracked", "fps", "klt ms", "pose ms",
               "deform ms", "solve ms", "linear ms", "total ms", "points");
   for (const std::string& preset : presets) {
-    nrslam::Renderer renderer(nrslam::SimPreset(preset));
+    const nrslam::SimOptions sim = nrslam::SimPreset(preset);
+    nrslam::Renderer renderer(sim);
     std::vector<nrslam::RenderedFrame> rendered;
     for (int i = 0; i < frames; ++i) rendered.push_back(renderer.Render(i));
+    // The first depth map as nrslam_run reads it from the sequence's PNG, so that both track
+    // the same map (the unrounded one sent sim-6 down another path).
+    const cv::Mat initial_depth_mm = nrslam::DecodeDepthMm(
+        nrslam::EncodeDepthMm(rendered[0].left.depth_mm, sim.depth_unit_mm), sim.depth_unit_mm);
     for (const std::string mode : {"deformable", "cgnr", "rigid"}) {
       nrslam::TrackingOptions tracking = options->tracking;
       tracking.rigid = mode == "rigid";
       if (mode == "cgnr") tracking.joint_linear_solver = "cgnr";
       nrslam::Tracker tracker(renderer.camera(), options->frontend, options->deformation, tracking);
-      tracker.InitialiseFromDepth(0, rendered[0].left.bgr, rendered[0].left.depth_mm, {});
+      tracker.InitialiseFromDepth(0, rendered[0].left.bgr, initial_depth_mm, {});
       double klt = 0, pose = 0, deformation = 0, solve = 0, linear = 0, total = 0, points = 0;
       int tracked = 0;
       for (int i = 1; i < frames; ++i) {

@@ -5,8 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "temp_folder.h"
+#include "nrslam/io/depth_encoding.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
@@ -197,6 +199,35 @@ TEST_F(SequenceReaderTest, FixedAndPerFrameMasksCombine) {
   EXPECT_EQ(mask.at<uint8_t>(10, 2), 0);   // fixed mask
   EXPECT_EQ(mask.at<uint8_t>(1, 20), 0);   // frame mask
   EXPECT_EQ(mask.at<uint8_t>(10, 20), 255);
+}
+
+// Depth is stored to the nearest unit; what cannot be stored (none, NaN, negative, beyond 16
+// bits) reads back as 0 = none, never as a clipped depth. A file written and read back holds
+// exactly the in-memory round trip, which is what benchmarks use to track the runner's map.
+TEST(DepthEncoding, RoundsToTheUnitAndKeepsNoneAsZero) {
+  const float depths[] = {12.344f, 12.346f, 0.0f, std::numeric_limits<float>::quiet_NaN(), -3.0f, 655.35f, 700.0f};
+  cv::Mat depth_mm(1, 7, CV_32F);
+  for (int i = 0; i < 7; ++i) depth_mm.at<float>(0, i) = depths[i];
+  const cv::Mat encoded = EncodeDepthMm(depth_mm, 0.01);
+  ASSERT_EQ(encoded.type(), CV_16UC1);
+  const uint16_t expected[] = {1234, 1235, 0, 0, 0, 65535, 0};
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(encoded.at<uint16_t>(0, i), expected[i]) << "column " << i;
+  const cv::Mat decoded = DecodeDepthMm(encoded, 0.01);
+  ASSERT_EQ(decoded.type(), CV_32F);
+  EXPECT_NEAR(decoded.at<float>(0, 0), 12.34f, 1e-5);
+  EXPECT_EQ(decoded.at<float>(0, 2), 0.0f);
+  EXPECT_NEAR(decoded.at<float>(0, 5), 655.35f, 1e-3);
+}
+
+TEST_F(SequenceReaderTest, WrittenDepthReadsBackAsTheInMemoryRoundTrip) {
+  cv::Mat depth_mm(30, 40, CV_32F);
+  cv::randu(depth_mm, 1.0, 400.0);
+  SequenceWriter(folder_, info_, true, SequenceWriter::Target::kExistingSequence).WriteDepthMm(5, depth_mm);
+  const cv::Mat read = SequenceReader(folder_).ReadDepthMm(5);
+  const cv::Mat in_memory = DecodeDepthMm(EncodeDepthMm(depth_mm, info_.depth_unit_mm), info_.depth_unit_mm);
+  EXPECT_EQ(cv::norm(read, in_memory, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(read, depth_mm, cv::NORM_INF), 0.0);  // the rounding is real
+  EXPECT_LE(cv::norm(read, depth_mm, cv::NORM_INF), 0.5 * info_.depth_unit_mm + 1e-4);
 }
 
 }  // namespace

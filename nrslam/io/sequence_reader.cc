@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "nrslam/io/depth_encoding.h"
 #include "nrslam/io/png_header.h"
 #include "nrslam/util/error.h"
 
@@ -159,10 +160,7 @@ cv::Mat SequenceReader::ReadRight(int index) const {
 
 cv::Mat SequenceReader::ReadDepthMm(int index) const {
   if (!has_depth_) throw Error("sequence " + folder_.string() + " has no depth ground truth");
-  cv::Mat raw = ReadImage("depth", index, cv::IMREAD_UNCHANGED, CV_16UC1);
-  cv::Mat depth_mm;
-  raw.convertTo(depth_mm, CV_32F, info_.depth_unit_mm);
-  return depth_mm;
+  return DecodeDepthMm(ReadImage("depth", index, cv::IMREAD_UNCHANGED, CV_16UC1), info_.depth_unit_mm);
 }
 
 cv::Mat SequenceReader::ReadMask(int index) const {

@@ -2,9 +2,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include <cmath>
 #include <fstream>
 
+#include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
 
@@ -61,18 +61,7 @@ void SequenceWriter::WriteRight(int index, const cv::Mat& bgr) const {
 }
 
 void SequenceWriter::WriteDepthMm(int index, const cv::Mat& depth_mm) const {
-  CV_Assert(depth_mm.type() == CV_32F);
-  cv::Mat encoded(depth_mm.size(), CV_16UC1);
-  const double inverse_unit = 1.0 / info_.depth_unit_mm;
-  for (int y = 0; y < depth_mm.rows; ++y) {
-    const float* in = depth_mm.ptr<float>(y);
-    uint16_t* out = encoded.ptr<uint16_t>(y);
-    for (int x = 0; x < depth_mm.cols; ++x) {
-      const double value = std::isfinite(in[x]) ? std::round(in[x] * inverse_unit) : 0.0;
-      out[x] = (value > 0 && value <= 65535) ? static_cast<uint16_t>(value) : 0;
-    }
-  }
-  WritePng(folder_ / "depth" / FrameFileName(index), encoded);
+  WritePng(folder_ / "depth" / FrameFileName(index), EncodeDepthMm(depth_mm, info_.depth_unit_mm));
 }
 
 void SequenceWriter::WriteFixedMask(const cv::Mat& mask) const {

@@ -29,8 +29,7 @@ class SequenceWriter {
 
   void WriteRgb(int index, const cv::Mat& bgr) const;
   void WriteRight(int index, const cv::Mat& bgr) const;
-  // Depth in mm (CV_32F, 0 or non-finite = none), stored as 16-bit multiples of depth_unit_mm;
-  // depths beyond the 16-bit range are stored as 0 (none) rather than clipped to a wrong value.
+  // Depth in mm (CV_32F, 0 or non-finite = none), stored in depth_unit_mm (EncodeDepthMm).
   void WriteDepthMm(int index, const cv::Mat& depth_mm) const;
   void WriteFixedMask(const cv::Mat& mask) const;
   void WriteGroundtruth(const std::vector<StampedPose>& poses) const;
