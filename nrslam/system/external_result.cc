@@ -272,8 +272,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
         births.AddFrame(ids, depth_points, depth_mm, frame_evaluation, !had_points && !points.empty());
       }
       had_points = had_points || !points.empty();
-      // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
-      if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
+      // Kept with its pairs for the alignments at the end; copied, since the lines below read it too.
+      if (frame_evaluation.evaluated) evaluations.push_back(frame_evaluation);
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));

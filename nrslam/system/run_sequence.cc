@@ -242,8 +242,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       }
       // Every tracked frame, with ground truth or not: a point is born once, where it first appears.
       births.AddFrame(ids, depth_points, depth_mm, evaluation, frame == map_start_frame);
-      // Its pairs move into the list (kept for the alignments at the end); the figures used below stay.
-      if (evaluation.evaluated) evaluations.push_back(std::move(evaluation));
+      // Kept with its pairs for the alignments at the end; copied, since the lines below read it too.
+      if (evaluation.evaluated) evaluations.push_back(evaluation);
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
       io.Write(out / "depth" / FrameFileName(frame),
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
