@@ -7,6 +7,7 @@
 #include "nrslam/system/system_options.h"
 #include "nrslam/tracking/tracking_options.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_table.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -28,6 +29,32 @@ TEST(JsonOptions, UnknownOptionIsAnErrorThatListsTheKnownOnes) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("unknown option 'deformation.amplitud_mm'"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("deformation.amplitude_mm"), std::string::npos);
+  }
+}
+
+// A mistyped or partial name gets the options it most likely meant, not a list of all of them;
+// a name close to none gets the whole list.
+TEST(JsonOptions, UnknownNamesSuggestTheCloseOptions) {
+  const std::vector<std::string> paths = {"deformation.k", "deformation.sigma_factor", "deformation.max_degree_D",
+                                          "deformation.stretch_threshold", "mapping.dba_window", "tracking.pose_sigma_px"};
+  EXPECT_EQ(UnknownOptionHint("sigma", paths), "did you mean deformation.sigma_factor or tracking.pose_sigma_px?");
+  EXPECT_EQ(UnknownOptionHint("stretch_treshold", paths), "did you mean deformation.stretch_threshold?");
+  EXPECT_EQ(UnknownOptionHint("mapping.dba_windw", paths), "did you mean mapping.dba_window?");
+  EXPECT_EQ(UnknownOptionHint("D", paths), "did you mean deformation.max_degree_D?");
+  // Short names allow no edit: "kk" is not taken for "k".
+  EXPECT_EQ(UnknownOptionHint("kk", paths), "known options: " + Join(paths, ", "));
+  EXPECT_EQ(UnknownOptionHint("viscosity", paths), "known options: " + Join(paths, ", "));
+  // Each unknown key of an options file gets its own hint.
+  try {
+    OptionsFromJson<SimOptions>(Json::parse(R"({"frame": 3, "deformation": {"amplitud_mm": 5}})"), "file.json");
+    FAIL() << "unknown keys were accepted";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    // "frame" is in colon.speed_mm_per_frame too; both are offered.
+    EXPECT_NE(message.find("unknown option 'frame' (did you mean colon.speed_mm_per_frame or frames?)"),
+              std::string::npos) << message;
+    EXPECT_NE(message.find("unknown option 'deformation.amplitud_mm' (did you mean deformation.amplitude_mm?)"),
+              std::string::npos) << message;
   }
 }
 

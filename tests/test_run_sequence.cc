@@ -447,6 +447,15 @@ TEST(SystemOptionsNames, UniqueLastNamesResolveToFullPaths) {
   EXPECT_EQ(ResolveRunAssignment("camera={\"a\": 1}"), "run.camera={\"a\": 1}");  // only the name resolved
   EXPECT_THROW(ResolveRunAssignment("min_points=5"), Error);  // evaluation, initialisation and tracking
   EXPECT_THROW(ResolveRunAssignment("kk=2"), Error);
+  // The paper's σ is sigma_factor times the initial map's depth spread: the name alone points there.
+  try {
+    ResolveRunAssignment("sigma=2");
+    FAIL() << "'sigma' resolved";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("deformation.sigma_factor"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("deformation.k,"), std::string::npos) << "the whole list: " << e.what();
+  }
   EXPECT_THROW(ResolveRunAssignment("k"), Error);
   // A command line's --set list: short names resolved, applied in order, values checked.
   const SystemOptions set = WithRunAssignments(SystemOptions{}, {"k=2", "mapping.dba_window=7", "k=3"});

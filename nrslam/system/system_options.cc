@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 
@@ -40,9 +41,8 @@ std::string ResolveRunOption(const std::string& name) {
     if (path.substr(dot == std::string::npos ? 0 : dot + 1) == name) matches.push_back(path);
   }
   if (matches.size() == 1) return matches.front();
-  std::string known;
-  for (const std::string& path : matches.empty() ? paths : matches) known += (known.empty() ? "" : ", ") + path;
-  throw Error("option '" + name + "' is " + (matches.empty() ? "unknown; options are: " : "ambiguous: ") + known);
+  if (matches.empty()) throw Error("option '" + name + "' is unknown; " + UnknownOptionHint(name, paths));
+  throw Error("option '" + name + "' is ambiguous: " + Join(matches, ", "));
 }
 
 std::string ResolveRunAssignment(const std::string& assignment) {

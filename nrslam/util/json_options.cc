@@ -1,5 +1,6 @@
 #include "nrslam/util/json_options.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -17,6 +18,22 @@ void CollectLeafPaths(const Json& node, const std::string& prefix, std::vector<s
   for (auto it = node.begin(); it != node.end(); ++it) {
     CollectLeafPaths(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
   }
+}
+
+// Levenshtein distance: the fewest single-character insertions, deletions and substitutions.
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
 }
 
 void CollectChanged(const Json& base, const Json& changed, const std::string& prefix, std::vector<std::string>* out) {
@@ -124,13 +141,34 @@ std::vector<std::string> LeafPaths(const Json& config) {
   return paths;
 }
 
+std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths) {
+  const auto last_part = [](const std::string& path) {
+    return path.substr(path.rfind('.') == std::string::npos ? 0 : path.rfind('.') + 1);
+  };
+  const std::string wanted = last_part(name);
+  // Short names allow fewer edits: within two edits of "kk" is half the options.
+  const size_t max_edits = wanted.size() < 3 ? 0 : wanted.size() < 8 ? 1 : 2;
+  std::vector<std::string> close;
+  for (const std::string& path : paths) {
+    const std::string candidate = last_part(path);
+    const bool contains = !wanted.empty() && candidate.find(wanted) != std::string::npos;
+    if (contains || EditDistance(wanted, candidate) <= max_edits) close.push_back(path);
+  }
+  if (close.empty()) return "known options: " + Join(paths, ", ");
+  const std::string last = close.back();
+  close.pop_back();
+  return "did you mean " + (close.empty() ? last : Join(close, ", ") + " or " + last) + "?";
+}
+
 void RejectMismatchedOptions(const Json& given, const Json& reference, const std::string& context) {
   if (!given.is_object()) throw Error(context + ": expected a JSON object");
   std::vector<std::string> unknown, mistyped;
   CollectMismatches(given, reference, "", &unknown, &mistyped);
   if (!unknown.empty()) {
-    throw Error(context + ": unknown option(s) " + Join(unknown, ", ") +
-                "; known options: " + Join(LeafPaths(reference), ", "));
+    const std::vector<std::string> known = LeafPaths(reference);
+    std::vector<std::string> named;
+    for (const std::string& path : unknown) named.push_back("unknown option '" + path + "' (" + UnknownOptionHint(path, known) + ")");
+    throw Error(context + ": " + Join(named, "; "));
   }
   if (!mistyped.empty()) throw Error(context + ": " + Join(mistyped, "; "));
 }
@@ -147,7 +185,7 @@ void ApplyAssignment(Json& config, const std::string& assignment) {
   std::string key;
   while (std::getline(parts, key, '.')) {
     if (!node->is_object() || !node->contains(key)) {
-      throw Error("unknown option '" + path + "'; known options: " + Join(LeafPaths(config), ", "));
+      throw Error("unknown option '" + path + "'; " + UnknownOptionHint(path, LeafPaths(config)));
     }
     node = &(*node)[key];
   }

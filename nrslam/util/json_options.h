@@ -42,6 +42,13 @@ Json ReadJsonFile(const std::filesystem::path& file);
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
 std::vector<std::string> LeafPaths(const Json& config);
 
+// What an error says after "unknown option 'name'": the options the name most likely meant
+// ("did you mean a or b?"), which are those whose last part contains the name's last part
+// ("sigma" finds every *sigma* option) or is within a few typing edits of it (two for a long
+// name: "stretch_treshold"; none under 3 characters); when none is that close, "known
+// options: " and all of them.
+std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths);
+
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
 // rejecting unknown keys and values of the wrong kind, then Check()s.
 template <typename Options>
