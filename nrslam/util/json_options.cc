@@ -146,7 +146,7 @@ std::string UnknownOptionHint(const std::string& name, const std::vector<std::st
     return path.substr(path.rfind('.') == std::string::npos ? 0 : path.rfind('.') + 1);
   };
   const std::string wanted = last_part(name);
-  // Short names allow fewer edits: within two edits of "kk" is half the options.
+  // Short names allow fewer edits: two edits rewrite most of a short name.
   const size_t max_edits = wanted.size() < 3 ? 0 : wanted.size() < 8 ? 1 : 2;
   std::vector<std::string> close;
   for (const std::string& path : paths) {
