@@ -13,6 +13,7 @@
 #include "nrslam/io/sequence_info.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
@@ -31,8 +32,6 @@ std::string StableHash(const std::string& text) {
   hex << std::hex << std::setw(16) << std::setfill('0') << hash;
   return hex.str().substr(0, 12);
 }
-
-std::string LastName(const std::string& path) { return path.substr(path.rfind('.') + 1); }
 
 std::vector<std::string> SplitList(const std::string& text) {
   std::vector<std::string> items;

@@ -1,8 +1,5 @@
 #include "nrslam/io/depth_encoding.h"
 
-#include <cmath>
-#include <cstdint>
-
 namespace nrslam {
 
 cv::Mat EncodeDepthMm(const cv::Mat& depth_mm, double unit_mm) {
@@ -12,10 +9,7 @@ cv::Mat EncodeDepthMm(const cv::Mat& depth_mm, double unit_mm) {
   for (int y = 0; y < depth_mm.rows; ++y) {
     const float* in = depth_mm.ptr<float>(y);
     uint16_t* out = encoded.ptr<uint16_t>(y);
-    for (int x = 0; x < depth_mm.cols; ++x) {
-      const double value = std::isfinite(in[x]) ? std::round(in[x] * inverse_unit) : 0.0;
-      out[x] = (value > 0 && value <= 65535) ? static_cast<uint16_t>(value) : 0;
-    }
+    for (int x = 0; x < depth_mm.cols; ++x) out[x] = DepthUnitsOrNone(in[x] * inverse_unit);
   }
   return encoded;
 }

@@ -272,8 +272,6 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
         births.AddFrame(ids, depth_points, depth_mm, frame_evaluation, !had_points && !points.empty());
       }
       had_points = had_points || !points.empty();
-      // Kept with its pairs for the alignments at the end; copied, since the lines below read it too.
-      if (frame_evaluation.evaluated) evaluations.push_back(frame_evaluation);
       for (const EstimatedPoint& point : points) {
         points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));
@@ -307,6 +305,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
                 << ",0,0,0,0,0,0,0,0,\"" << (tracked ? "" : "no estimate") << "\"\n";
+    // Last used here, so its pairs move into the list kept for the alignments at the end.
+    if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }
   AggregateInto(&summary, evaluations, aligned, evaluation);
   summary.births = births.Summarise();

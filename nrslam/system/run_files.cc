@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/source_revision.h"
 
@@ -109,12 +110,12 @@ std::ofstream OpenForWriting(const std::filesystem::path& path) {
 cv::Mat SplatDepth(const std::vector<DepthPoint>& points, double to_mm, const cv::Size& size, double unit_mm) {
   cv::Mat depth = cv::Mat::zeros(size, CV_16UC1);
   for (const DepthPoint& point : points) {
-    const double value = std::round(to_mm * point.depth / unit_mm);
-    if (!(value > 0) || value > 65535) continue;
+    const uint16_t value = DepthUnitsOrNone(to_mm * point.depth / unit_mm);
+    if (value == 0) continue;
     const int cx = cvRound(point.pixel.x), cy = cvRound(point.pixel.y);
     for (int y = std::max(0, cy - 1); y <= std::min(size.height - 1, cy + 1); ++y) {
       for (int x = std::max(0, cx - 1); x <= std::min(size.width - 1, cx + 1); ++x) {
-        depth.at<uint16_t>(y, x) = static_cast<uint16_t>(value);
+        depth.at<uint16_t>(y, x) = value;
       }
     }
   }

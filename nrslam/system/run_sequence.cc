@@ -242,8 +242,6 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       }
       // Every tracked frame, with ground truth or not: a point is born once, where it first appears.
       births.AddFrame(ids, depth_points, depth_mm, evaluation, frame == map_start_frame);
-      // Kept with its pairs for the alignments at the end; copied, since the lines below read it too.
-      if (evaluation.evaluated) evaluations.push_back(evaluation);
       const cv::Size size(reader.info().camera.width(), reader.info().camera.height());
       io.Write(out / "depth" / FrameFileName(frame),
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
@@ -267,6 +265,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       line << "  " << std::fixed << std::setprecision(1) << result.ms_total << " ms";
       progress(frame + 1 - first, summary.frames_total, line.str());
     }
+    // Last used here, so its pairs move into the list kept for the alignments at the end.
+    if (evaluation.evaluated) evaluations.push_back(std::move(evaluation));
   }
   io.Finish();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();

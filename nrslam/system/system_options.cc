@@ -37,8 +37,7 @@ std::string ResolveRunOption(const std::string& name) {
   if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
   std::vector<std::string> matches;
   for (const std::string& path : paths) {
-    const size_t dot = path.rfind('.');
-    if (path.substr(dot == std::string::npos ? 0 : dot + 1) == name) matches.push_back(path);
+    if (LastName(path) == name) matches.push_back(path);
   }
   if (matches.size() == 1) return matches.front();
   if (matches.empty()) throw Error("option '" + name + "' is unknown; " + UnknownOptionHint(name, paths));

@@ -141,16 +141,15 @@ std::vector<std::string> LeafPaths(const Json& config) {
   return paths;
 }
 
+std::string LastName(const std::string& path) { return path.substr(path.rfind('.') + 1); }  // npos + 1 == 0
+
 std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths) {
-  const auto last_part = [](const std::string& path) {
-    return path.substr(path.rfind('.') == std::string::npos ? 0 : path.rfind('.') + 1);
-  };
-  const std::string wanted = last_part(name);
+  const std::string wanted = LastName(name);
   // Short names allow fewer edits: two edits rewrite most of a short name.
   const size_t max_edits = wanted.size() < 3 ? 0 : wanted.size() < 8 ? 1 : 2;
   std::vector<std::string> close;
   for (const std::string& path : paths) {
-    const std::string candidate = last_part(path);
+    const std::string candidate = LastName(path);
     const bool contains = !wanted.empty() && candidate.find(wanted) != std::string::npos;
     if (contains || EditDistance(wanted, candidate) <= max_edits) close.push_back(path);
   }

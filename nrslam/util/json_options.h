@@ -42,6 +42,9 @@ Json ReadJsonFile(const std::filesystem::path& file);
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
 std::vector<std::string> LeafPaths(const Json& config);
 
+// The last part of a dotted option path ("amplitude_mm"); the path itself when it has no dot.
+std::string LastName(const std::string& path);
+
 // What an error says after "unknown option 'name'": the options the name most likely meant
 // ("did you mean a or b?"), which are those whose last part contains the name's last part
 // ("sigma" finds every *sigma* option) or is within a few typing edits of it (two for a long
