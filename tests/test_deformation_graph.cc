@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <random>
 
@@ -68,6 +69,53 @@ TEST(DeformationGraph, EachPointUsesItsBestDEdgesByWeight) {
   EXPECT_EQ(wide.BestNeighbours(0).size(), 12u);  // 0.5 … 6.0: all within 1.5σ
   wide.set_sigma(2.0);                             // now only d <= 3 qualifies
   EXPECT_EQ(wide.BestNeighbours(0).size(), 6u);
+}
+
+// Equal weights are ranked by id, and a neighbour the caller rules out leaves its slot to the
+// next best, however many better ones it outranks.
+TEST(DeformationGraph, TiesGoToTheLowerIdAndIneligibleNeighboursLeaveTheirSlot) {
+  DeformationModelOptions options;
+  options.max_degree_D = 3;
+  DeformationGraph graph(options, 4.0);
+  Positions positions;
+  positions.at[0] = {0, 0, 0};
+  for (int i = 1; i <= 12; ++i) {  // all at distance 1 from point 0, in an order unlike their ids
+    const double angle = 2.0 * M_PI * ((i * 5) % 12) / 12.0;
+    positions.at[i] = {std::cos(angle), std::sin(angle), 0};
+  }
+  positions.at[13] = {0.5, 0, 0};  // the one nearer neighbour
+  graph.ConnectCovisible({0}, positions.Ids(), positions.Lookup());
+  const auto ids = [](const std::vector<GraphNeighbour>& best) {
+    std::vector<PointId> out;
+    for (const GraphNeighbour& neighbour : best) out.push_back(neighbour.id);
+    return out;
+  };
+  EXPECT_EQ(ids(graph.BestNeighbours(0)), (std::vector<PointId>{13, 1, 2}));
+  const auto odd_only = [](PointId id) { return id % 2 == 1; };
+  EXPECT_EQ(ids(graph.BestNeighbours(0, odd_only)), (std::vector<PointId>{13, 1, 3}));
+  const auto above_eight = [](PointId id) { return id > 8; };
+  EXPECT_EQ(ids(graph.BestNeighbours(0, above_eight)), (std::vector<PointId>{13, 9, 10}));
+  EXPECT_TRUE(graph.BestNeighbours(0, [](PointId) { return false; }).empty());
+}
+
+// Re-measuring a few points reaches every edge with one end among them and a position at the
+// other, and no edge between two others.
+TEST(DeformationGraph, UpdatingSomePointsMeasuresExactlyTheEdgesThatTouchThem) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 10.0);
+  Positions positions;
+  positions.at = {{0, {0, 0, 0}}, {1, {1, 0, 0}}, {2, {0, 1, 0}}, {3, {1, 1, 0}}};
+  graph.ConnectCovisible(positions.Ids(), {}, positions.Lookup());
+  for (auto& [id, position] : positions.at) position *= 2.0;
+  Positions without_three = positions;
+  without_three.at.erase(3);
+  graph.UpdatePoints({1, 0}, without_three.Lookup());
+  const auto longest = [&](PointId a, PointId b) { return graph.edge(*graph.FindEdge(a, b)).max_length; };
+  EXPECT_DOUBLE_EQ(longest(0, 1), 2.0);
+  EXPECT_DOUBLE_EQ(longest(0, 2), 2.0);
+  EXPECT_DOUBLE_EQ(longest(1, 2), 2.0 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(longest(0, 3), std::sqrt(2.0));  // no position for 3: untouched
+  EXPECT_DOUBLE_EQ(longest(2, 3), 1.0);             // neither end listed
 }
 
 // The pairs a solver regularises among a subset of the points: exactly the union of each

@@ -196,6 +196,7 @@ class ListPositions {
   }
   bool Contains(PointId id) const { return static_cast<size_t>(id) < position_.size() && At(id) >= 0; }
   int At(PointId id) const { return position_[static_cast<size_t>(id)]; }
+  size_t size() const { return position_.size(); }
 
  private:
   std::vector<int> position_;  // −1: not listed
@@ -206,16 +207,27 @@ class ListPositions {
 void DeformationGraph::UpdatePoints(const std::vector<PointId>& points, const PositionLookup& position) {
   CheckLive(points);
   const ListPositions listed(points);
-  for (PointId point : points) {
-    const auto node = nodes_.find(point);
-    if (node == nodes_.end()) continue;
-    const auto here = position(point);
-    if (!here) continue;
-    for (const Incidence& incidence : node->second.edges) {
-      if (incidence.other < point && listed.Contains(incidence.other)) continue;  // measured from its other end
-      const auto there = position(incidence.other);
-      if (there) Remeasure(incidence.edge, (*here - *there).norm());
+  // The edges in storage order, one pass over memory rather than a jump per neighbour (a
+  // complete graph gives each point hundreds), and each point's position looked up once.
+  std::vector<std::optional<Eigen::Vector3d>> known(listed.size());
+  std::vector<bool> looked_up(listed.size(), false);
+  const auto located = [&](PointId id) {
+    const auto slot = static_cast<size_t>(id);
+    if (slot >= known.size()) {
+      known.resize(slot + 1);
+      looked_up.resize(slot + 1, false);
     }
+    if (!looked_up[slot]) {
+      known[slot] = position(id);
+      looked_up[slot] = true;
+    }
+    return known[slot];
+  };
+  for (size_t index = 0; index < edges_.size(); ++index) {
+    const GraphEdge& edge = edges_[index];
+    if (edge.a == kNoPoint || !(listed.Contains(edge.a) || listed.Contains(edge.b))) continue;
+    const std::optional<Eigen::Vector3d> here = located(edge.a), there = located(edge.b);
+    if (here && there) Remeasure(static_cast<int>(index), (*here - *there).norm());
   }
 }
 
@@ -245,19 +257,23 @@ void DeformationGraph::SelectBest(PointId point, const Eligible& eligible, std::
   best->clear();
   const auto node = nodes_.find(point);
   if (node == nodes_.end()) return;
+  // The best D so far, best first: highest b, ties broken by id so the choice never depends
+  // on insertion order. A complete graph gives a point hundreds of edges of which D are kept,
+  // so an edge that would not enter is set aside before `eligible` is asked about it.
+  const auto better = [](double weight, PointId id, const GraphNeighbour& than) {
+    return weight != than.weight ? weight > than.weight : id < than.id;
+  };
+  const auto degree = static_cast<size_t>(options_.max_degree_D);
   for (const auto& [other, index] : node->second.edges) {
     const double weight = ranking_weight_[index];
     if (weight < 0.0) continue;
+    if (best->size() == degree && !better(weight, other, best->back())) continue;
     if (!eligible(other)) continue;
-    best->push_back({other, index, weight});
+    if (best->size() == degree) best->pop_back();
+    auto slot = best->end();
+    while (slot != best->begin() && better(weight, other, *(slot - 1))) --slot;
+    best->insert(slot, {other, index, weight});
   }
-  const size_t keep = std::min(best->size(), static_cast<size_t>(options_.max_degree_D));
-  // Ties broken by id so the choice never depends on insertion order.
-  std::partial_sort(best->begin(), best->begin() + keep, best->end(),
-                    [](const GraphNeighbour& x, const GraphNeighbour& y) {
-                      return x.weight != y.weight ? x.weight > y.weight : x.id < y.id;
-                    });
-  best->resize(keep);
 }
 
 std::vector<GraphNeighbour> DeformationGraph::BestNeighbours(PointId point,
