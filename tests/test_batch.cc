@@ -24,6 +24,7 @@
 #include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/seed_groups.h"
+#include "nrslam/batch/svg_plot.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
@@ -56,6 +57,36 @@ std::string ErrorOf(const std::filesystem::path& manifest) {
 
 // A tiny simulated sequence: enough frames and points to track, quick to render and run.
 constexpr const char* kTinySimulate = R"({"frames": 8, "camera.width": 320, "camera.height": 240})";
+
+// A sweep's plot has one series per sequence: the legend wraps into rows inside the plot's
+// width, names each named series once, and leaves out the unnamed ones (a run's later maps).
+TEST(SvgPlot, LegendWrapsInsideThePlotAndNamesEachNamedSeriesOnce) {
+  std::vector<PlotSeries> series;
+  for (int i = 0; i < 8; ++i) series.push_back({"sequence-" + std::to_string(i), "#123456", {0, 1}, {i, i + 1.0}});
+  series.push_back({"", "#654321", {0, 1}, {2, 3}});
+  PlotOptions options{"RMSE against k", "k", "RMSE (mm)", 520, 300, false};
+  const std::string svg = LinePlotSvg(series, options);
+  const std::regex legend_text("<text x=\"([0-9.e+-]+)\" y=\"([0-9.e+-]+)\">([^<]*)</text>");
+  std::set<double> rows;
+  int entries = 0;
+  for (auto match = std::sregex_iterator(svg.begin(), svg.end(), legend_text); match != std::sregex_iterator();
+       ++match) {
+    const std::string name = (*match)[3];
+    if (name.rfind("sequence-", 0) != 0) continue;
+    ++entries;
+    const double x = std::stod((*match)[1]);
+    EXPECT_GE(x, 0);
+    EXPECT_LE(x + 7.0 * static_cast<double>(name.size()), options.width) << name;
+    rows.insert(std::stod((*match)[2]));
+    EXPECT_EQ(svg.find(">" + name + "</text>", match->position() + match->length()), std::string::npos) << name << " twice";
+  }
+  EXPECT_EQ(entries, 8);
+  EXPECT_GT(rows.size(), 1u);                          // 8 names do not fit one row of 520 px
+  EXPECT_EQ(svg.find("\"></text>"), std::string::npos);  // no entry for the unnamed series
+  size_t polylines = 0;
+  for (size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) ++polylines;
+  EXPECT_EQ(polylines, series.size());  // every series is drawn, named or not
+}
 
 TEST(Manifest, EachMistakeIsNamed) {
   const auto folder = UniqueTempFolder("manifest_errors");

@@ -97,6 +97,25 @@ TEST(TrajectoryError, MapsThatCannotBeAlignedAreLeftOut) {
   EXPECT_EQ(AlignedTrajectoryError({}).evaluated, false);
 }
 
+// The centres the error is taken over (what the report plots): an exact map lands on the
+// truth, a noisy one at the known distance, one that cannot be aligned gives none.
+TEST(TrajectoryError, AlignedCentresAreTheOnesTheErrorMeasures) {
+  const NoisyGrid exact(0.0), noisy(0.5);
+  const auto on_truth = AlignedCentres(exact.map);
+  ASSERT_TRUE(on_truth);
+  ASSERT_EQ(on_truth->size(), exact.map.groundtruth.size());
+  for (size_t i = 0; i < on_truth->size(); ++i) EXPECT_LT(((*on_truth)[i] - exact.map.groundtruth[i]).norm(), 1e-9);
+  const auto off_truth = AlignedCentres(noisy.map);
+  ASSERT_TRUE(off_truth);
+  double squared = 0;
+  for (size_t i = 0; i < off_truth->size(); ++i) squared += ((*off_truth)[i] - noisy.map.groundtruth[i]).squaredNorm();
+  EXPECT_NEAR(std::sqrt(squared / static_cast<double>(off_truth->size())), noisy.expected_rmse, 1e-9);
+  TrajectorySegment short_map;
+  short_map.estimated = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0)};
+  short_map.groundtruth = short_map.estimated;
+  EXPECT_FALSE(AlignedCentres(short_map));
+}
+
 TEST(TrajectoryError, BadInputIsAnError) {
   TrajectorySegment mismatched;
   mismatched.estimated = {Eigen::Vector3d::Zero()};

@@ -11,6 +11,7 @@
 #include "nrslam/batch/svg_plot.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/eval/error_view.h"
+#include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/text_table.h"
 
@@ -26,13 +27,13 @@ std::string Slug(const RunResult& result) {
   return slug;
 }
 
-// Camera positions of a TUM file by timestamp, in the ground truth's world: the estimate's
-// world is its first camera, so it is carried over with that frame's true pose.
-struct Trajectories {
-  PlotSeries estimate{"estimate", "#d62728", {}, {}}, truth{"ground truth", "#222", {}, {}};
-};
-Trajectories TopView(const std::filesystem::path& estimate_file, const std::vector<StampedPose>& truth) {
-  Trajectories plot;
+// Camera positions of a TUM file beside the true ones, top view. A map's world has its own
+// scale and gauge (a monocular map is in map units), so each map's estimated centres are
+// carried onto the true ones by the similarity the ATE column uses; each map is its own
+// polyline, since nothing joins the worlds of two maps.
+std::vector<PlotSeries> TopView(const std::filesystem::path& estimate_file, const std::vector<StampedPose>& truth,
+                     const std::map<int, int>& map_of_frame) {
+  std::vector<PlotSeries> plot;
   const std::vector<StampedPose> estimate = ReadTum(estimate_file);
   if (estimate.empty() || truth.empty()) return plot;
   auto nearest = [&](double t) {
@@ -40,16 +41,30 @@ Trajectories TopView(const std::filesystem::path& estimate_file, const std::vect
     for (size_t i = 1; i < truth.size(); ++i) {
       if (std::abs(truth[i].timestamp - t) < std::abs(truth[best].timestamp - t)) best = i;
     }
-    return truth[best].world_from_camera;
+    return best;
   };
-  const Rigid3 world_from_first = nearest(estimate.front().timestamp);
+  PlotSeries true_path{"ground truth", "#222", {}, {}};
+  std::map<int, TrajectorySegment> maps;
   for (const StampedPose& pose : estimate) {
-    const Eigen::Vector3d position = (world_from_first * pose.world_from_camera).translation;
-    plot.estimate.x.push_back(position.x());
-    plot.estimate.y.push_back(position.z());
-    const Eigen::Vector3d true_position = nearest(pose.timestamp).translation;
-    plot.truth.x.push_back(true_position.x());
-    plot.truth.y.push_back(true_position.z());
+    const size_t frame = nearest(pose.timestamp);
+    const auto map = map_of_frame.find(static_cast<int>(frame));
+    TrajectorySegment& segment = maps[map == map_of_frame.end() ? 1 : map->second];
+    segment.estimated.push_back(pose.world_from_camera.translation);
+    segment.groundtruth.push_back(truth[frame].world_from_camera.translation);
+    true_path.x.push_back(segment.groundtruth.back().x());
+    true_path.y.push_back(segment.groundtruth.back().z());
+  }
+  plot.push_back(std::move(true_path));
+  for (const auto& [map, segment] : maps) {
+    const auto centres = AlignedCentres(segment);
+    if (!centres) continue;
+    // One legend entry for all maps.
+    PlotSeries aligned{plot.size() == 1 ? "estimate" : "", "#d62728", {}, {}};
+    for (const Eigen::Vector3d& centre : *centres) {
+      aligned.x.push_back(centre.x());
+      aligned.y.push_back(centre.z());
+    }
+    plot.push_back(std::move(aligned));
   }
   return plot;
 }
@@ -78,10 +93,12 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
     // The evaluator's scale relative to its map's first: what one scale per map pays for.
     PlotSeries drift{"frame scale / map's first", "#2ca02c", {}, {}};
     std::map<int, double> first_scale;  // per map
+    std::map<int, int> map_of_frame;
     std::vector<int> tracked;
     for (const auto& row : metrics) {
       if (row.at("state") != "tracking") continue;
       const int frame = static_cast<int>(Number(row, "frame"));
+      if (row.count("map") != 0) map_of_frame[frame] = static_cast<int>(Number(row, "map"));
       rmse.x.push_back(frame);
       rmse.y.push_back(Number(row, "rmse_mm"));
       if (row.count("rmse_flat_mm") != 0) {
@@ -103,8 +120,8 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
                                     520, 300, false});
     }
     if (sequence.has_groundtruth() && std::filesystem::exists(run / "trajectory.tum")) {
-      const Trajectories top = TopView(run / "trajectory.tum", sequence.groundtruth());
-      html << LinePlotSvg({top.truth, top.estimate}, {"Trajectory, top view", "x (mm)", "z (mm)", 520, 300, true});
+      html << LinePlotSvg(TopView(run / "trajectory.tum", sequence.groundtruth(), map_of_frame),
+                          {"Trajectory, top view (each map aligned as for the ATE)", "x (mm)", "z (mm)", 520, 300, true});
     }
     html << "</div>\n";
     if (sequence.has_depth() && tracked.size() > 1) {

@@ -53,8 +53,30 @@ std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions
   if (!options.equal_aspect) y_min = std::min(y_min, 0.0);  // error plots start at zero
   if (x_max - x_min < 1e-9) x_max = x_min + 1;
   if (y_max - y_min < 1e-9) y_max = y_min + 1;
-  const double left = 56, right = 12, top = 28, bottom = 40;
-  const double plot_w = options.width - left - right, plot_h = options.height - top - bottom;
+  const double left = 56, right = 12, bottom = 40;
+  const double plot_w = options.width - left - right;
+  // The legend (series with a name) flows in rows under the title, as many as it needs: a
+  // sweep plots one series per sequence.
+  struct LegendEntry {
+    const PlotSeries* series;
+    double x;
+    int row;
+  };
+  std::vector<LegendEntry> legend;
+  double legend_x = left;
+  int legend_row = 0;
+  for (const PlotSeries& s : series) {
+    if (s.name.empty()) continue;
+    const double entry_width = 20 + 7 * static_cast<double>(s.name.size()) + 12;
+    if (legend_x > left && legend_x + entry_width > left + plot_w) {
+      legend_x = left;
+      ++legend_row;
+    }
+    legend.push_back({&s, legend_x, legend_row});
+    legend_x += entry_width;
+  }
+  const double top = 28 + (legend.empty() ? 0 : 14 * (legend_row + 1));
+  const double plot_h = options.height - top - bottom;
   if (options.equal_aspect) {  // grow the smaller range so one unit is as long on both axes
     const double scale = std::max((x_max - x_min) / plot_w, (y_max - y_min) / plot_h);
     const double cx = 0.5 * (x_min + x_max), cy = 0.5 * (y_min + y_max);
@@ -88,12 +110,11 @@ std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions
       << EscapeXml(options.x_label) << "</text>\n";
   svg << "<text transform=\"translate(14," << top + plot_h / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
       << EscapeXml(options.y_label) << "</text>\n";
-  double legend_x = left + plot_w;
-  for (auto s = series.rbegin(); s != series.rend(); ++s) {
-    legend_x -= 12 + 7 * static_cast<double>(s->name.size()) + 20;
-    svg << "<line x1=\"" << legend_x << "\" y1=\"" << top - 8 << "\" x2=\"" << legend_x + 16 << "\" y2=\"" << top - 8
-        << "\" stroke=\"" << s->colour << "\" stroke-width=\"2\"/><text x=\"" << legend_x + 20 << "\" y=\"" << top - 4
-        << "\">" << EscapeXml(s->name) << "</text>\n";
+  for (const LegendEntry& entry : legend) {
+    const double y = 30 + 14 * entry.row;
+    svg << "<line x1=\"" << entry.x << "\" y1=\"" << y - 4 << "\" x2=\"" << entry.x + 16 << "\" y2=\"" << y - 4
+        << "\" stroke=\"" << entry.series->colour << "\" stroke-width=\"2\"/><text x=\"" << entry.x + 20 << "\" y=\"" << y
+        << "\">" << EscapeXml(entry.series->name) << "</text>\n";
   }
   for (const PlotSeries& s : series) {
     std::ostringstream points;

@@ -23,7 +23,8 @@ struct PlotOptions {
 // Text made safe inside HTML/SVG elements and attribute values.
 std::string EscapeXml(const std::string& text);
 
-// An <svg> element (class "plot") with axes, ticks, the series and a legend.
+// An <svg> element (class "plot") with axes, ticks, the series and a legend of the series
+// that have a name.
 std::string LinePlotSvg(const std::vector<PlotSeries>& series, const PlotOptions& options);
 
 }  // namespace nrslam

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <vector>
 
 namespace nrslam {
@@ -28,5 +29,10 @@ struct TrajectoryError {
 };
 
 TrajectoryError AlignedTrajectoryError(const std::vector<TrajectorySegment>& maps);
+
+// The map's estimated camera centres carried onto the true ones by that least-squares
+// similarity, in ground-truth units: what the error above measures, e.g. to plot. nullopt
+// when the map cannot be aligned (fewer than 3 frames, or a camera that did not move).
+std::optional<std::vector<Eigen::Vector3d>> AlignedCentres(const TrajectorySegment& map);
 
 }  // namespace nrslam
