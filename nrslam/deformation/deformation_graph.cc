@@ -264,6 +264,7 @@ void DeformationGraph::SelectBest(PointId point, const Eligible& eligible, std::
     return weight != than.weight ? weight > than.weight : id < than.id;
   };
   const auto degree = static_cast<size_t>(options_.max_degree_D);
+  best->reserve(degree);  // one allocation per list, not one per doubling (a list per lost point per frame)
   for (const auto& [other, index] : node->second.edges) {
     const double weight = ranking_weight_[index];
     if (weight < 0.0) continue;
