@@ -62,7 +62,7 @@ constexpr const char* kTinySimulate = R"({"frames": 8, "camera.width": 320, "cam
 // width, names each named series once, and leaves out the unnamed ones (a run's later maps).
 TEST(SvgPlot, LegendWrapsInsideThePlotAndNamesEachNamedSeriesOnce) {
   std::vector<PlotSeries> series;
-  for (int i = 0; i < 8; ++i) series.push_back({"sequence-" + std::to_string(i), "#123456", {0, 1}, {i, i + 1.0}});
+  for (int i = 0; i < 8; ++i) series.push_back({"sequence-" + std::to_string(i), "#123456", {0, 1}, {static_cast<double>(i), i + 1.0}});
   series.push_back({"", "#654321", {0, 1}, {2, 3}});
   PlotOptions options{"RMSE against k", "k", "RMSE (mm)", 520, 300, false};
   const std::string svg = LinePlotSvg(series, options);
@@ -1177,16 +1177,21 @@ std::filesystem::path StandInRunner(const std::filesystem::path& folder, const s
   return runner;
 }
 
+// Runs a shell command with its standard output and error caught in `log`: its exit status and
+// what it printed.
+std::pair<int, std::string> RunCaught(const std::string& command, const std::filesystem::path& log) {
+  const int status = std::system((command + " > " + log.string() + " 2>&1").c_str());
+  std::ifstream stream(log);
+  return {status, std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>())};
+}
+
 // Out-of-range arguments are refused with a message naming them, not replaced by a default or
 // wrapped around: each command exits non-zero, writes nothing, and says what was wrong.
 TEST(Tools, OutOfRangeArgumentsAreRefused) {
   const auto folder = UniqueTempFolder("tool_arguments");
   std::filesystem::create_directories(folder);
-  const std::string log = (folder / "log.txt").string();
   const auto refused = [&](const std::string& command, const std::string& message) {
-    const int status = std::system((command + " > " + log + " 2>&1").c_str());
-    std::ifstream stream(log);
-    const std::string output((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    const auto [status, output] = RunCaught(command, folder / "log.txt");
     EXPECT_NE(status, 0) << command;
     EXPECT_NE(output.find(message), std::string::npos) << command << "\n" << output;
   };
@@ -1202,6 +1207,26 @@ TEST(Tools, OutOfRangeArgumentsAreRefused) {
   refused(eval + " --jobs 0", "--jobs: Value 0 not in range 1 to 256");
   refused(eval + " --sweep deformation.k=1,inf", "cannot use 'inf' (expected a finite number");
   EXPECT_FALSE(std::filesystem::exists(folder / "out" / "results.json"));
+  std::filesystem::remove_all(folder);
+}
+
+// `nrslam_run --print-options` needs no sequence: it prints every option as resolved (here
+// after a --set) and exits 0. Without it, the sequence and the run folder are both required.
+TEST(Tools, RunPrintsItsOptionsWithoutASequence) {
+  const auto folder = UniqueTempFolder("tool_print_options");
+  std::filesystem::create_directories(folder);
+  const std::string run = kPrograms.run.string();
+  const auto [status, output] = RunCaught(run + " --print-options --set deformation.k=2.5", folder / "options.json");
+  ASSERT_EQ(status, 0) << output;
+  const nlohmann::json options = nlohmann::json::parse(output);
+  EXPECT_DOUBLE_EQ(options.at("deformation").at("k").get<double>(), 2.5);
+  EXPECT_EQ(options.at("tracking").at("max_points").get<int>(), SystemOptions{}.tracking.max_points);
+  const auto [no_sequence, no_sequence_output] = RunCaught(run, folder / "log.txt");
+  EXPECT_NE(no_sequence, 0);
+  EXPECT_NE(no_sequence_output.find("a sequence folder is required"), std::string::npos) << no_sequence_output;
+  const auto [no_out, no_out_output] = RunCaught(run + " " + (folder / "seq").string(), folder / "log.txt");
+  EXPECT_NE(no_out, 0);
+  EXPECT_NE(no_out_output.find("--out is required"), std::string::npos) << no_out_output;
   std::filesystem::remove_all(folder);
 }
 

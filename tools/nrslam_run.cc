@@ -14,8 +14,9 @@ int main(int argc, char** argv) {
   std::string sequence, out, config_path, init;
   bool rigid = false, no_mapping = false, quiet = false, print_options = false;
   std::vector<std::string> assignments;
-  app.add_option("sequence", sequence, "sequence folder")->required();
-  app.add_option("--out", out, "run folder to write")->required();
+  // Not marked required: --print-options needs neither (checked after parsing).
+  app.add_option("sequence", sequence, "sequence folder (required unless --print-options)");
+  app.add_option("--out", out, "run folder to write (required unless --print-options)");
   app.add_option("--config", config_path, "JSON options applied over the defaults: a run folder's config.json (to repeat that run) or an options object");
   app.add_option("--init", init, "monocular (the map from the images: full NR-SLAM, the default) or depth (from the sequence's depth)");
   app.add_flag("--rigid", rigid, "rigid baseline: no deformation");
@@ -24,6 +25,11 @@ int main(int argc, char** argv) {
   app.add_flag("--print-options", print_options, "print every option as JSON and exit");
   app.add_flag("--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
+  if (!print_options && (sequence.empty() || out.empty())) {
+    std::cerr << "nrslam_run: " << (sequence.empty() ? "a sequence folder" : "--out") << " is required\n"
+              << "Run with --help for more information.\n";
+    return 1;
+  }
   try {
     // Defaults, then the file, then the flags given, then --set: each overrides the one before.
     nrslam::SystemOptions options = config_path.empty() ? nrslam::SystemOptions{} : nrslam::SystemOptionsFromFile(config_path);
