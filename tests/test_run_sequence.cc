@@ -687,7 +687,7 @@ TEST(MonocularRun, AnOcamCalibratedLensIsTrackedToTheEnd) {
 
 TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
   // sim-3: A = 5 mm, ω = 2.5 rad/s. The deformation's apparent motion is as large as the
-  // camera's early on, so the two-view map is poor (README, "Mapping"): only tracking and
+  // camera's early on, so the two-view map is poor (docs/mapping.md): only tracking and
   // map growth are pinned here, not accuracy.
   const MonocularOutcome outcome = RunMonocular("sim-3", SystemOptions{});
   ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
@@ -784,9 +784,10 @@ TEST(MonocularRun, EpipolarGateKeepsFewerGrosslyMisplacedNewPoints) {
   EXPECT_LT(outcome.new_point_gross_error_fraction, 0.8 * reference.new_point_gross_error_fraction);
 }
 
-// The shading prior (frontend/shading.h) with its companions, as the README's colonoscopy
-// configuration sets them: brightness-corrected initial and new deformable points, and a rigid
-// warm-up kept only where one shape fits.
+// The shading prior (frontend/shading.h) with its companions, as the colonoscopy
+// configuration data_manifests/paper-sim-monocular-shading.json sets them: brightness-
+// corrected initial and new deformable points, and a rigid warm-up kept only where one shape
+// fits.
 SystemOptions ShadingConfiguration() {
   SystemOptions options;
   options.initialisation.shading_weight = 1;
@@ -797,7 +798,7 @@ SystemOptions ShadingConfiguration() {
 
 TEST(MonocularRun, ShadingPriorCorrectsTheTwoViewMapOfADeformingColon) {
   // sim-3: two views a few frames apart of tissue that moves as far as the camera give poor
-  // depths (README, "Mapping"); the brightness of a tube lit from the tip does not depend on
+  // depths (docs/mapping.md); the brightness of a tube lit from the tip does not depend on
   // the motion.
   const MonocularOutcome reference = RunMonocular("sim-3", SystemOptions{}, 640, 480);
   const MonocularOutcome outcome = RunMonocular("sim-3", ShadingConfiguration(), 640, 480);

@@ -1,5 +1,5 @@
 // batch: runs that differ only in the simulator's scene seed, summarised together. Single
-// runs are chaotic (README "Mapping"), so a preset is best judged over several renderings of
+// runs are chaotic (docs/mapping.md), so a preset is best judged over several renderings of
 // it (e.g. colon-seeds-monocular.json: seeds 1–3 of each colon preset); this gives, per
 // preset, mode and sweep point, the mean and spread of the RMSE over its seeds.
 #pragma once

@@ -7,7 +7,7 @@
 // least-squares scale leans towards far points): 0 for a point born where the frame's other
 // points put the map, negative for one born too near. Tracking keeps a point's ratio to the
 // truth, so a mean below zero compounds as points turn over and the map shrinks (top-level
-// README, "Long runs").
+// docs/mapping.md, "Long runs").
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -5,7 +5,7 @@
 // of its distance r: linear brightness I ∝ ρ·cos θ / r², and r ∝ I^(−1/2) up to the albedo ρ and
 // the incidence θ, which this model leaves as noise. The unknown factor (light power, exposure,
 // the map's scale) is one per image: it is fitted to points whose distances are known. Neither
-// the paper nor the reference uses this cue; it is off by default (README, "Mapping").
+// the paper nor the reference uses this cue; it is off by default (docs/mapping.md).
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -13,7 +13,7 @@ struct InitialisationOptions {
   int min_tracks = 100;              // fewer tracks from the reference frame: restart from this frame
   // Frames; an older reference is replaced by the current frame. The reference's 30 never let
   // the fisheye lap-lobes initialise (the camera creeps at 66–130 mm depth); 60 does, at frame
-  // 58, and changes nothing that initialised within 30 (README, "Mapping").
+  // 58, and changes nothing that initialised within 30 (docs/mapping.md).
   int max_reference_age = 60;
   int ransac_iterations = 200;       // 8-point samples (the reference draws 16 bucketed ones)
   double epipolar_threshold_px = 2.5;  // E inlier: angle to the epipolar plane, in pixel angles (the reference's 0.005 rad at 0.002 rad/px)
@@ -33,7 +33,7 @@ struct InitialisationOptions {
   // as far as the camera give poor depths; the brightness does not depend on the motion. It
   // suits a tube lit from the tip and hurts where incidence and albedo vary more than distance
   // (lap-lobes) or where two views are already good (a still scene); use it with
-  // mapping.rigid_warmup_min_inliers, else the rigid warm-up undoes it (README, "Mapping").
+  // mapping.rigid_warmup_min_inliers, else the rigid warm-up undoes it (docs/mapping.md).
   // 0 = off (the paper).
   double shading_weight = 0;
   // Initial DDG: "complete" joins every pair of initial points (the reference); "flow_clusters"
@@ -66,7 +66,7 @@ struct MappingOptions {
   // DDG's rest shape: the map's depths get corrected by the growing baseline before the
   // per-keyframe shapes can absorb their error (counting the initial two). A map from depth
   // is left alone (warming it up made depth-initialised runs worse). 0 = off (the
-  // reference); 4 measured best of 0, 4, 6, 8, 12 on the suite (README, "Mapping").
+  // reference); 4 measured best of 0, 4, 6, 8, 12 on the suite (docs/mapping.md).
   int rigid_warmup_keyframes = 4;
   // The warm-up's rigid result is kept only when at least this fraction of the window's
   // observations reprojects within max_reprojection_px2; otherwise the window gets the
@@ -91,7 +91,7 @@ struct MappingOptions {
   // measured in 3D. At 320×240 without it, rigid windows took deforming sim-1 and sim-3 maps
   // from 0.9 / 1.6 to 4.9 / 5.6 mm. Not for two-view maps: there δ also carry corrections of
   // the map's depths (a still scene's reached 0.0030, against at most 0.0015 from depth), and
-  // over 42 monocular renderings the test was better on 3 and worse on 5 (README, "Mapping").
+  // over 42 monocular renderings the test was better on 3 and worse on 5 (docs/mapping.md).
   // 0 = no such test.
   double rigid_dba_max_deformation = 0.004;
   // New points from 2D tracks (corners detected at keyframes) over the last frames.
@@ -107,7 +107,7 @@ struct MappingOptions {
   // Deformable triangulation and the paper's model selection between it and rigid
   // triangulation. Without it a deforming scene gets almost no new points (the rigidity
   // gate) and is lost once the camera leaves the initial map; with it the map keeps growing,
-  // at a cost in accuracy over short runs (README, "Mapping").
+  // at a cost in accuracy over short runs (docs/mapping.md).
   bool deformable_triangulation = true;
   // Deformable triangulation's plausibility gate: the rigid two-ray midpoint must reproject
   // within max_reprojection_px2 in both views, with deformable_min_parallax_px between them.
@@ -121,7 +121,7 @@ struct MappingOptions {
   // never). A starving map needs new points more than it needs the stricter gate. A fraction
   // rather than a count, so that it holds at any image size. Not for maps from depth: they
   // start accurate, and the looser gate's points cost them more than they add (measured in
-  // the top-level README, "Mapping").
+  // docs/mapping.md).
   double shortest_gate_below_fraction = 0.35;
   // On those frames, whether the gate's two rays must also reproject within
   // max_reprojection_px2. Even over the shortest span the tissue moves about as far as the
@@ -135,7 +135,7 @@ struct MappingOptions {
   // not, the fit's depth along a low-parallax ray is mostly its seed, the neighbours' depth.
   // Not on starving frames (shortest_gate_below_fraction): there the map needs points more.
   // 0 = off (the reference). 1.25 measured better than off on 18 of 21 colon renderings and
-  // 5 of 6 lap-lobes renderings (README, "Mapping").
+  // 5 of 6 lap-lobes renderings (docs/mapping.md).
   double deformable_agreement_ratio = 1.25;
   // A deformable candidate is fitted only if its track's rays stay near their epipolar planes
   // with its oldest ray: their rms angle to those planes, over the oldest-to-newest parallax,
@@ -147,7 +147,7 @@ struct MappingOptions {
   // The same on starving frames (shortest_gate_below_fraction), looser because the map needs
   // points there: at 0 (no check) the points those frames made undid most of the gain; at the
   // main ratio (0.1 or 0.15) or 0.2 the 300-frame sim-3 run had 6-99 frames under 100 tracked
-  // points after frame 30, at 0.3 none (README, "Mapping").
+  // points after frame 30, at 0.3 none (docs/mapping.md).
   double starving_max_epipolar_ratio = 0.3;
   double deformable_min_parallax_px = 5;
   double flow_sigma = 0.1;           // σ of the neighbour-flow residual, × map scale
@@ -156,7 +156,7 @@ struct MappingOptions {
   // function_tolerance; 1e-6 is its default). Along a ray with little parallax the cost is
   // nearly flat, so the fit stops a few steps from its seed: at 1e-14 the new points' depths
   // follow their tracks more, but 14 of the 21 colon renderings came out worse and a
-  // 1000-frame run from depth lost its track (README, "Long runs").
+  // 1000-frame run from depth lost its track (docs/mapping.md, "Long runs").
   double deformable_function_tolerance = 1e-6;
   double flow_outlier_chi2 = 7.815;  // reject if more than half the flow residuals exceed it ...
   double reprojection_outlier_chi2 = 59.9;  // ... or more than half the reprojections exceed this
@@ -166,7 +166,7 @@ struct MappingOptions {
   // along their ray to log r = w·log r_shading + (1 − w)·log r, the brightness calibrated on the
   // frame's tracked points. Rigid triangulation passed its rigidity and parallax gates and is
   // left alone. At 1 it holds a deforming colon's map scale over 1000 frames, where without it
-  // the scale collapses; it costs the still scene and lap-lobes (README, "Long runs").
+  // the scale collapses; it costs the still scene and lap-lobes (docs/mapping.md, "Long runs").
   // 0 = off (the paper).
   double new_point_shading_weight = 0;
   void Check() const;

@@ -19,11 +19,11 @@ struct TrackingOptions {
   int deformation_iterations = 10;    // ... of this many LM iterations each
   // Linear solver of that problem: "sparse_cholesky" (Eigen's simplicial LDLT, exact steps)
   // or "cgnr" (conjugate gradients, block-Jacobi preconditioned: the deformation stage ~1.35×
-  // faster, as accurate when tracking alone, but less accurate with mapping; README "Tracking").
+  // faster, but less accurate with mapping, and from depth on sim-6; docs/tracking.md).
   std::string joint_linear_solver = "sparse_cholesky";
   // Trust-region strategy of that problem: "levenberg_marquardt" (the reference) or "dogleg",
   // which re-uses a step's linear solve when the region shrinks instead of factorising again:
-  // tracking 0–14 % faster, accuracy mixed over the seed renderings (README "Tracking").
+  // tracking 0–14 % faster, accuracy mixed over the seed renderings (docs/tracking.md).
   std::string joint_trust_region = "levenberg_marquardt";
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
   double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
@@ -36,7 +36,7 @@ struct TrackingOptions {
   // constant-velocity seed already carries, and which no residual can tell from it).
   // Only where the solves start changes, not what they minimise (not in the reference).
   // Measured better when tracking a map from depth (`--no-mapping`), worse with mapping,
-  // where δ also carries corrections to the map (README "Tracking").
+  // where δ also carries corrections to the map (docs/tracking.md).
   bool deformation_motion_seed = false;
   // Mid-term re-association: a lost map point is looked for again by a KLT seeded at its
   // projection, with the patch of the keyframe it was last tracked from.
