@@ -17,7 +17,7 @@ struct Alignment {
 
 std::optional<Alignment> Align(const TrajectorySegment& map) {
   if (map.estimated.size() != map.groundtruth.size()) {
-    throw Error("AlignedTrajectoryError: a map has different numbers of estimated and true poses");
+    throw Error("trajectory alignment: a map has different numbers of estimated and true poses");
   }
   const auto n = static_cast<Eigen::Index>(map.estimated.size());
   Eigen::Matrix3Xd estimated(3, n), groundtruth(3, n);
@@ -25,7 +25,7 @@ std::optional<Alignment> Align(const TrajectorySegment& map) {
     estimated.col(i) = map.estimated[static_cast<size_t>(i)];
     groundtruth.col(i) = map.groundtruth[static_cast<size_t>(i)];
   }
-  if (!estimated.allFinite() || !groundtruth.allFinite()) throw Error("AlignedTrajectoryError: a non-finite pose");
+  if (!estimated.allFinite() || !groundtruth.allFinite()) throw Error("trajectory alignment: a non-finite pose");
   // A camera that did not move gives no scale to align.
   const Eigen::Vector3d mean = estimated.rowwise().mean();
   if (n < 3 || (estimated.colwise() - mean).squaredNorm() == 0) return std::nullopt;
