@@ -23,5 +23,17 @@ fi
 sudo_cmd=()
 [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
 echo "install_deps: installing ${missing[*]}"
-"${sudo_cmd[@]}" apt-get update -qq
-DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# A mirror that drops a connection now and then should not fail a CI run: apt retries each
+# download, and the whole update or install is tried again after a pause.
+apt_options=(-o Acquire::Retries=5)
+retry() {
+  local attempt
+  for attempt in 1 2 3; do
+    "$@" && return 0
+    [ "$attempt" -lt 3 ] && { echo "install_deps: '$*' failed (attempt $attempt of 3), retrying in 20 s" >&2; sleep 20; }
+  done
+  return 1
+}
+retry "${sudo_cmd[@]}" apt-get "${apt_options[@]}" update -qq
+retry "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get "${apt_options[@]}" install -y -qq \
+  --no-install-recommends "${missing[@]}"
