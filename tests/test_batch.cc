@@ -1230,6 +1230,30 @@ TEST(Tools, RunPrintsItsOptionsWithoutASequence) {
   std::filesystem::remove_all(folder);
 }
 
+// Into a log file (as under Slurm or GNU parallel) progress comes as whole lines, not as
+// carriage returns that pile a run's every update onto one line.
+TEST(Tools, ProgressIntoALogFileIsWholeLines) {
+  const auto folder = UniqueTempFolder("tool_progress_log");
+  std::filesystem::create_directories(folder);
+  const std::string sequence = (folder / "seq").string();
+  const auto [rendered, render_log] = RunCaught(
+      kPrograms.simulate.string() + " --preset sim-1 --frames 12 --width 160 --height 120 --out " + sequence,
+      folder / "render.txt");
+  ASSERT_EQ(rendered, 0) << render_log;
+  EXPECT_EQ(render_log.find('\r'), std::string::npos) << render_log;
+  EXPECT_NE(render_log.find("rendering sim-1: frame 12/12"), std::string::npos) << render_log;
+  const auto [ran, run_log] =
+      RunCaught(kPrograms.run.string() + " " + sequence + " --init depth --out " + (folder / "run").string(),
+                folder / "run.txt");
+  ASSERT_EQ(ran, 0) << run_log;
+  EXPECT_EQ(run_log.find('\r'), std::string::npos) << run_log;
+  // The first update and the last, not one per frame (the interval is 10 s).
+  EXPECT_NE(run_log.find("frame 1/12"), std::string::npos) << run_log;
+  EXPECT_NE(run_log.find("frame 12/12"), std::string::npos) << run_log;
+  EXPECT_EQ(run_log.find("frame 6/12"), std::string::npos) << run_log;
+  std::filesystem::remove_all(folder);
+}
+
 TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   const auto folder = UniqueTempFolder("batch_crash");
   EvaluationPlan plan;

@@ -6,6 +6,7 @@
 
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/progress_line.h"
 #include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
@@ -41,9 +42,9 @@ int main(int argc, char** argv) {
       std::cout << nrslam::Json(options).dump(2) << '\n';
       return 0;
     }
+    nrslam::ProgressLine progress = nrslam::ProgressLine::OnStderr();
     const nrslam::RunSummary summary = nrslam::RunSequence(sequence, options, out, [&](int done, int total, const std::string& line) {
-      if (!quiet) std::cerr << '\r' << line << "      " << std::flush;
-      if (!quiet && done == total) std::cerr << '\n';
+      if (!quiet) progress.Update(line, done == total);
     });
     std::cout << nrslam::DescribeSummary(summary) << '\n';
     std::cout << "run folder: " << out << '\n';

@@ -9,18 +9,9 @@
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/progress_line.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
-
-namespace {
-
-void PrintProgress(const std::string& name, int done, int total, double ms_per_frame) {
-  std::cerr << "\rrendering " << name << ": frame " << done << "/" << total << " ("
-            << nrslam::FormatFixed(ms_per_frame, 1) << " ms/frame)" << std::flush;
-  if (done == total) std::cerr << '\n';
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Render simulated endoscopy sequences with exact depth ground truth."};
@@ -78,12 +69,16 @@ int main(int argc, char** argv) {
     const std::vector<std::string> names = suite ? nrslam::SimPresetNames() : std::vector<std::string>{preset};
     nrslam::TextTable table({"sequence", "frames", "resolution", "camera", "depth min (mm)", "depth max (mm)",
                              "render ms/frame", "write ms/frame"});
+    nrslam::ProgressLine progress = nrslam::ProgressLine::OnStderr();
     for (const std::string& name : names) {
       const nrslam::SimOptions options = resolve(name);
       const std::filesystem::path folder = suite ? std::filesystem::path(out) / name : std::filesystem::path(out);
       if (overwrite) nrslam::RemoveSequence(folder);
       const auto summary = nrslam::SimulateSequence(options, name, folder, [&](int done, int total, double ms) {
-        if (!quiet) PrintProgress(name, done, total, ms);
+        if (quiet) return;
+        progress.Update("rendering " + name + ": frame " + std::to_string(done) + "/" + std::to_string(total) + " (" +
+                            nrslam::FormatFixed(ms, 1) + " ms/frame)",
+                        done == total);
       });
       table.AddRow({name, std::to_string(summary.frames),
                     std::to_string(summary.width) + "x" + std::to_string(summary.height),

@@ -10,6 +10,7 @@
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/progress_line.h"
 #include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
@@ -35,12 +36,15 @@ int main(int argc, char** argv) {
     info.provenance["depth"] = {{"generator", std::string("nrslam_stereo_gt ") + NRSLAM_VERSION},
                                 {"options", nrslam::Json(options)}};
     const nrslam::SequenceWriter writer(folder, info, true, nrslam::SequenceWriter::Target::kExistingSequence);
+    nrslam::ProgressLine progress = nrslam::ProgressLine::OnStderr();
     for (int i = 0; i < sequence.frame_count(); ++i) {
       writer.WriteDepthMm(i, nrslam::StereoDepthMm(sequence.ReadRgb(i), sequence.ReadRight(i), info.camera.fx(),
                                                    info.stereo->baseline_mm, options));
-      if (!quiet) std::cerr << "\rdepth " << i + 1 << "/" << sequence.frame_count() << std::flush;
+      if (!quiet) {
+        progress.Update("depth " + std::to_string(i + 1) + "/" + std::to_string(sequence.frame_count()),
+                        i + 1 == sequence.frame_count());
+      }
     }
-    if (!quiet) std::cerr << '\n';
     std::cout << "wrote depth for " << sequence.frame_count() << " frames into " << folder << "/depth\n";
   } catch (const std::exception& e) {
     std::cerr << "nrslam_stereo_gt: " << e.what() << '\n';
