@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -270,6 +271,65 @@ TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
   };
   refused({ParseSweep("k=1,2,1")}, "deformation.k: value 1 is given twice");
   refused({ParseSweep("k=1"), ParseSweep("deformation.k=2")}, "deformation.k is swept twice");
+  // Two options with one last name would label their runs alike.
+  refused({ParseSweep("tracking.min_points=10"), ParseSweep("initialisation.min_points=50")},
+          "two swept options are named 'min_points'");
+  std::filesystem::remove_all(folder);
+}
+
+// A simulator option swept renders the presets once per value (into the cache, keyed by the
+// simulator's arguments) and runs each value on its own rendering; run options are not touched.
+TEST(Sweep, SimulatorOptionsRenderThePresetsAnewPerValue) {
+  const auto folder = UniqueTempFolder("sweep_simulator");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [
+      {"name": "s", "preset": "sim-3", "simulate": {"deformation.amplitude_mm": 2.5, "frames": 30}},
+      {"name": "s-rigid", "preset": "sim-3", "simulate": {"deformation.amplitude_mm": 2.5, "frames": 30}, "rigid": true}]})"));
+  const EvaluationPlan plan = PlanEvaluation(
+      manifest, {}, {ParseSweep("simulate.amplitude_mm=0,10"), ParseSweep("k=0.5,2")}, folder / "out", folder / "cache");
+  ASSERT_EQ(plan.runs.size(), 8u);
+  ASSERT_EQ(plan.prepares.size(), 2u);  // one rendering per amplitude, shared by both sequences and both k
+  const auto renders = [&](size_t prepare, const std::string& assignment) {
+    const std::vector<std::string>& arguments = plan.prepares[prepare].arguments;
+    return std::find(arguments.begin(), arguments.end(), assignment) != arguments.end();
+  };
+  EXPECT_TRUE(renders(0, "deformation.amplitude_mm=0"));  // the sweep's value replaces the manifest's 2.5
+  EXPECT_FALSE(renders(0, "deformation.amplitude_mm=2.5"));
+  EXPECT_TRUE(renders(0, "frames=30"));                   // and the manifest's other options stay
+  EXPECT_TRUE(renders(1, "deformation.amplitude_mm=10"));
+  for (const RunJob& run : plan.runs) {
+    const bool zero = run.label.rfind("amplitude_mm=0,", 0) == 0;
+    EXPECT_EQ(run.prepare, zero ? 0 : 1) << run.label;
+    EXPECT_EQ(run.sequence_folder, plan.prepares[run.prepare].folder);
+    EXPECT_EQ(run.arguments.front(), run.sequence_folder.string());
+    // nrslam_run gets the run option, never the simulator's.
+    EXPECT_EQ(std::count_if(run.arguments.begin(), run.arguments.end(),
+                            [](const std::string& a) {
+                              return a.rfind("simulate.", 0) == 0 || a.rfind("deformation.amplitude", 0) == 0;
+                            }),
+              0);
+    EXPECT_NE(std::find(run.arguments.begin(), run.arguments.end(), run.point[1]), run.arguments.end()) << run.label;
+  }
+  EXPECT_EQ(plan.runs[1].label, "amplitude_mm=0,k=2");
+  EXPECT_EQ(plan.runs[1].point[0], "simulate.deformation.amplitude_mm=0");
+  EXPECT_EQ(plan.runs[1].run_folder, std::filesystem::absolute(folder / "out" / "runs" / "s" / "amplitude_mm=0,k=2"));
+
+  const auto refused = [&](const std::function<void()>& plan_it, const std::string& message) {
+    try {
+      plan_it();
+      ADD_FAILURE() << "accepted; expected: " << message;
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
+    }
+  };
+  refused([] { ParseSweep("simulate.amplitude=1,2"); }, "did you mean colon.bend_amplitude_mm or deformation.amplitude_mm?");
+  refused([] { ParseSweep("amplitude_mm=1,2"); }, "a simulator option; to render the presets anew for each value, sweep "
+                                                  "simulate.deformation.amplitude_mm");
+  refused([] { ParseSweep("simulate.seed=1,2"); }, "with --seeds");
+  refused([&] { PlanEvaluation(manifest, {}, {ParseSweep("simulate.amplitude_mm=5,40")}, folder / "out", folder / "cache"); },
+          "sequence 's' at amplitude_mm=40: simulate: sim deformation: amplitude_mm must be in [0, 30]");
+  const Manifest on_disk = LoadManifest(WriteFile(folder / "d.json", R"({"sequences": [{"name": "d", "path": "seq"}]})"));
+  refused([&] { PlanEvaluation(on_disk, {}, {ParseSweep("simulate.amplitude_mm=5")}, folder / "out", folder / "cache"); },
+          "sequence 'd' is not rendered from a preset");
   std::filesystem::remove_all(folder);
 }
 

@@ -134,7 +134,9 @@ int main(int argc, char** argv) {
   app.add_option("--config", config_path, "JSON options for every sequence (a run's config.json or an options "
                                           "object): those that differ from the defaults, before --set");
   app.add_option("--set", assignments, "set a run option for every sequence, e.g. --set k=2 or deformation.k=2");
-  app.add_option("--sweep", sweeps, "run a grid: --sweep k=0.5,1.1,2 --sweep max_degree_D=3,5,10");
+  app.add_option("--sweep", sweeps,
+                 "run a grid: --sweep k=0.5,1.1,2 --sweep max_degree_D=3,5,10; a simulator option renders the presets "
+                 "anew per value: --sweep simulate.amplitude_mm=0,5,10");
   app.add_option("--only", only,
                  "evaluate only these sequences of the manifest: names or shell wildcards, e.g. --only sim-3 "
                  "'lap-*' (before --seeds adds -seedN)");

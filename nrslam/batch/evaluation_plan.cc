@@ -9,8 +9,10 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include "nrslam/io/sequence_info.h"
+#include "nrslam/sim/sim_options.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
@@ -20,6 +22,9 @@
 
 namespace nrslam {
 namespace {
+
+// Sweep paths of simulator options start with this; the rest is nrslam_simulate's path.
+constexpr std::string_view kSimulatorPrefix = "simulate.";
 
 // FNV-1a: a cache key that is the same on every machine and build.
 std::string StableHash(const std::string& text) {
@@ -60,12 +65,38 @@ std::string LastLine(const std::filesystem::path& log) {
 
 }  // namespace
 
+bool IsSimulatorAssignment(const std::string& assignment) {
+  return assignment.compare(0, kSimulatorPrefix.size(), kSimulatorPrefix) == 0;
+}
+
 Sweep ParseSweep(const std::string& text) {
   const size_t equals = text.find('=');
   if (equals == std::string::npos || equals == 0 || equals + 1 == text.size()) {
     throw Error("--sweep '" + text + "': expected name=value1,value2,...");
   }
-  Sweep sweep{ResolveRunOption(text.substr(0, equals)), SplitList(text.substr(equals + 1))};
+  const std::string name = text.substr(0, equals);
+  static const std::vector<std::string> simulator_paths = LeafPaths(Json(SimOptions{}));
+  std::string path;
+  if (IsSimulatorAssignment(name)) {
+    const std::string simulator_path =
+        ResolveOptionName(name.substr(kSimulatorPrefix.size()), simulator_paths, "--sweep: simulator option");
+    // Seeds make renderings of the same scene family; they have their own flag and summary.
+    if (simulator_path == "seed") throw Error("--sweep: sweep the scene seed with --seeds, e.g. --seeds 1-3");
+    path = std::string(kSimulatorPrefix) + simulator_path;
+  } else {
+    try {
+      path = ResolveRunOption(name);
+    } catch (const Error&) {
+      // A simulator option given without its prefix gets the spelling that sweeps it.
+      const auto simulator = std::find_if(simulator_paths.begin(), simulator_paths.end(), [&](const std::string& p) {
+        return p == name || LastName(p) == name;
+      });
+      if (simulator == simulator_paths.end()) throw;
+      throw Error("--sweep: '" + name + "' is a simulator option; to render the presets anew for each value, sweep " +
+                  std::string(kSimulatorPrefix) + *simulator);
+    }
+  }
+  Sweep sweep{path, SplitList(text.substr(equals + 1))};
   for (const std::string& value : sweep.values) {
     if (value.empty()) throw Error("--sweep '" + text + "': empty value");
   }
@@ -127,15 +158,74 @@ Manifest WithSceneSeeds(const Manifest& manifest, const std::vector<uint64_t>& s
   return seeded;
 }
 
+namespace {
+
+// The render or import that makes `sequence`'s folder, added to the plan once however many
+// runs read it: its index in plan->prepares, or -1 for a sequence already on disk.
+int AddPrepare(const ManifestSequence& sequence, const std::filesystem::path& cache_folder, EvaluationPlan* plan) {
+  if (sequence.preset.empty() && sequence.import.empty()) return -1;
+  PrepareJob job;
+  job.import = !sequence.import.empty();
+  if (job.import) {
+    job.arguments = sequence.import;
+    for (size_t i = 0; i + 1 < job.arguments.size(); i += 2) {
+      if (job.arguments[i] == "--format" || job.arguments[i] == "--in") {
+        job.description += (job.description.empty() ? "" : " ") + job.arguments[i + 1];
+      }
+    }
+  } else {
+    job.arguments = {"--preset", sequence.preset, "--quiet"};
+    for (const std::string& assignment : sequence.simulate) {
+      job.arguments.push_back("--set");
+      job.arguments.push_back(assignment);
+    }
+    job.description = sequence.preset;
+  }
+  std::string key;
+  for (const std::string& argument : job.arguments) key += argument + "\n";
+  const std::string stem = job.import ? sequence.name : sequence.preset;
+  job.folder = cache_folder / (stem + "-" + StableHash(key));
+  for (size_t i = 0; i < plan->prepares.size(); ++i) {
+    if (plan->prepares[i].folder == job.folder) return static_cast<int>(i);
+  }
+  plan->prepares.push_back(job);
+  return static_cast<int>(plan->prepares.size()) - 1;
+}
+
+// `sequence` rendered with a sweep point's simulator assignments over its own.
+ManifestSequence WithSimulatorPoint(ManifestSequence sequence, const std::vector<std::string>& point) {
+  for (const std::string& assignment : point) {
+    if (!IsSimulatorAssignment(assignment)) continue;
+    const std::string simulator_assignment = assignment.substr(kSimulatorPrefix.size());
+    const std::string path = simulator_assignment.substr(0, simulator_assignment.find('=') + 1);  // "a.b="
+    sequence.simulate.erase(std::remove_if(sequence.simulate.begin(), sequence.simulate.end(),
+                                           [&](const std::string& a) { return a.compare(0, path.size(), path) == 0; }),
+                            sequence.simulate.end());
+    sequence.simulate.push_back(simulator_assignment);
+  }
+  std::sort(sequence.simulate.begin(), sequence.simulate.end());
+  WithAssignments(SimPreset(sequence.preset), sequence.simulate);  // throws on a value out of range
+  return sequence;
+}
+
+}  // namespace
+
 EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::string>& extra,
                               const std::vector<Sweep>& sweeps, const std::filesystem::path& out,
                               const std::filesystem::path& cache) {
   EvaluationPlan plan;
   // A point given twice would be two runs writing into one folder at once; an option swept
-  // twice would leave one of its sweeps without effect.
-  std::set<std::string> swept;
+  // twice would leave one of its sweeps without effect; two options with one last name would
+  // label their runs alike.
+  std::set<std::string> swept, labels;
+  bool simulator_sweep = false;
   for (const Sweep& sweep : sweeps) {
     if (!swept.insert(sweep.path).second) throw Error("--sweep: " + sweep.path + " is swept twice");
+    if (!labels.insert(LastName(sweep.path)).second) {
+      throw Error("--sweep: two swept options are named '" + LastName(sweep.path) +
+                  "', and a run folder is labelled by that name");
+    }
+    simulator_sweep |= IsSimulatorAssignment(sweep.path);
     std::set<std::string> values;
     for (const std::string& value : sweep.values) {
       if (!values.insert(value).second) throw Error("--sweep " + sweep.path + ": value " + value + " is given twice");
@@ -156,40 +246,9 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
   const std::filesystem::path cache_folder = std::filesystem::absolute(cache);
   const std::filesystem::path out_folder = std::filesystem::absolute(out);
   for (const ManifestSequence& sequence : manifest.sequences) {
-    int prepare = -1;
-    std::filesystem::path folder = sequence.path;
-    if (!sequence.preset.empty() || !sequence.import.empty()) {
-      PrepareJob job;
-      job.import = !sequence.import.empty();
-      if (job.import) {
-        job.arguments = sequence.import;
-        for (size_t i = 0; i + 1 < job.arguments.size(); i += 2) {
-          if (job.arguments[i] == "--format" || job.arguments[i] == "--in") {
-            job.description += (job.description.empty() ? "" : " ") + job.arguments[i + 1];
-          }
-        }
-      } else {
-        job.arguments = {"--preset", sequence.preset, "--quiet"};
-        for (const std::string& assignment : sequence.simulate) {
-          job.arguments.push_back("--set");
-          job.arguments.push_back(assignment);
-        }
-        job.description = sequence.preset;
-      }
-      std::string key;
-      for (const std::string& argument : job.arguments) key += argument + "\n";
-      const std::string stem = job.import ? sequence.name : sequence.preset;
-      job.folder = cache_folder / (stem + "-" + StableHash(key));
-      for (size_t i = 0; i < plan.prepares.size() && prepare < 0; ++i) {
-        if (plan.prepares[i].folder == job.folder) prepare = static_cast<int>(i);
-      }
-      if (prepare < 0) {
-        prepare = static_cast<int>(plan.prepares.size());
-        plan.prepares.push_back(job);
-      }
-      folder = job.folder;
-    }
     if (sequence.is_external()) {
+      const int prepare = AddPrepare(sequence, cache_folder, &plan);
+      const std::filesystem::path folder = prepare < 0 ? sequence.path : plan.prepares[prepare].folder;
       RunJob run;
       run.sequence = sequence.name;
       run.sequence_folder = folder;
@@ -205,6 +264,10 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
       plan.runs.push_back(std::move(run));
       continue;
     }
+    if (simulator_sweep && sequence.preset.empty()) {
+      throw Error("--sweep of a simulator option: sequence '" + sequence.name +
+                  "' is not rendered from a preset, so it cannot be rendered anew; leave it out with --only");
+    }
     for (const auto& point : points) {
       RunJob run;
       run.sequence = sequence.name;
@@ -213,22 +276,32 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
         run.label += (run.label.empty() ? "" : ",") + LastName(assignment.substr(0, assignment.find('='))) +
                      assignment.substr(assignment.find('='));
       }
-      run.sequence_folder = folder;
+      const std::string where = "sequence '" + sequence.name + "'" + (run.label.empty() ? "" : " at " + run.label);
+      ManifestSequence rendered = sequence;
+      if (simulator_sweep) {
+        try {
+          rendered = WithSimulatorPoint(sequence, point);
+        } catch (const Error& e) {
+          throw Error(where + ": simulate: " + e.what());
+        }
+      }
+      run.prepare = AddPrepare(rendered, cache_folder, &plan);
+      run.sequence_folder = run.prepare < 0 ? sequence.path : plan.prepares[run.prepare].folder;
       run.run_folder = out_folder / "runs" / sequence.name;
       if (!run.label.empty()) run.run_folder /= run.label;
-      run.prepare = prepare;
       std::vector<std::string> assignments = sequence.assignments;
       assignments.insert(assignments.end(), extra.begin(), extra.end());
-      assignments.insert(assignments.end(), point.begin(), point.end());
+      for (const std::string& assignment : point) {
+        if (!IsSimulatorAssignment(assignment)) assignments.push_back(assignment);
+      }
       SystemOptions options;
       options.tracking.rigid = sequence.rigid;
       try {
         run.options = WithAssignments(options, assignments);
       } catch (const Error& e) {
-        throw Error("sequence '" + sequence.name + "'" + (run.label.empty() ? "" : " at " + run.label) + ": " +
-                    e.what());
+        throw Error(where + ": " + e.what());
       }
-      run.arguments = {folder.string(), "--out", run.run_folder.string(), "--quiet"};
+      run.arguments = {run.sequence_folder.string(), "--out", run.run_folder.string(), "--quiet"};
       if (sequence.rigid) run.arguments.push_back("--rigid");
       for (const std::string& assignment : assignments) {
         run.arguments.push_back("--set");

@@ -13,13 +13,20 @@
 
 namespace nrslam {
 
-// One swept option: every value is run, in a grid with the other sweeps.
+// One swept option: every value is run, in a grid with the other sweeps. A run option
+// ("deformation.k") changes how each sequence is run; a simulator option ("simulate." and its
+// nrslam_simulate path, e.g. "simulate.deformation.amplitude_mm") changes the data: each value
+// renders the manifest's presets anew, as a study of how the system copes with, say, a larger
+// deformation needs.
 struct Sweep {
-  std::string path;                 // resolved run option path
+  std::string path;                 // resolved: a run option path, or "simulate." + a simulator path
   std::vector<std::string> values;  // as given on the command line
 };
-// Parses "name=v1,v2,v3" (name as for ResolveRunOption); throws Error when malformed.
+// Parses "name=v1,v2,v3" (name as for ResolveRunOption, or "simulate." and a simulator option
+// by its path or unique last name); throws Error when malformed or unknown.
 Sweep ParseSweep(const std::string& text);
+// Whether a sweep point's "path=value" sets a simulator option ("simulate.…").
+bool IsSimulatorAssignment(const std::string& assignment);
 
 // A simulator assignment that sets the scene seed: "seed=3".
 bool IsSeedAssignment(const std::string& assignment);

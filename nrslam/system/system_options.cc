@@ -1,11 +1,9 @@
 #include "nrslam/system/system_options.h"
 
-#include <algorithm>
 #include <string>
 #include <vector>
 
 #include "nrslam/util/json_options.h"
-#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 
@@ -34,14 +32,7 @@ std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options) {
 
 std::string ResolveRunOption(const std::string& name) {
   static const std::vector<std::string> paths = LeafPaths(Json(SystemOptions{}));
-  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
-  std::vector<std::string> matches;
-  for (const std::string& path : paths) {
-    if (LastName(path) == name) matches.push_back(path);
-  }
-  if (matches.size() == 1) return matches.front();
-  if (matches.empty()) throw Error("option '" + name + "' is unknown; " + UnknownOptionHint(name, paths));
-  throw Error("option '" + name + "' is ambiguous: " + Join(matches, ", "));
+  return ResolveOptionName(name, paths, "option");
 }
 
 std::string ResolveRunAssignment(const std::string& assignment) {

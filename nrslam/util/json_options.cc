@@ -159,6 +159,17 @@ std::string UnknownOptionHint(const std::string& name, const std::vector<std::st
   return "did you mean " + (close.empty() ? last : Join(close, ", ") + " or " + last) + "?";
 }
 
+std::string ResolveOptionName(const std::string& name, const std::vector<std::string>& paths, const std::string& kind) {
+  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
+  std::vector<std::string> matches;
+  for (const std::string& path : paths) {
+    if (LastName(path) == name) matches.push_back(path);
+  }
+  if (matches.size() == 1) return matches.front();
+  if (matches.empty()) throw Error(kind + " '" + name + "' is unknown; " + UnknownOptionHint(name, paths));
+  throw Error(kind + " '" + name + "' is ambiguous: " + Join(matches, ", "));
+}
+
 void RejectMismatchedOptions(const Json& given, const Json& reference, const std::string& context) {
   if (!given.is_object()) throw Error(context + ": expected a JSON object");
   std::vector<std::string> unknown, mistyped;

@@ -52,6 +52,10 @@ std::string LastName(const std::string& path);
 // options: " and all of them.
 std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths);
 
+// `name` as one of `paths`: the path itself, or the only path whose last part it is ("k" for
+// "deformation.k"). Throws Error "<kind> 'name' is unknown; <hint>" or "... is ambiguous: a, b".
+std::string ResolveOptionName(const std::string& name, const std::vector<std::string>& paths, const std::string& kind);
+
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
 // rejecting unknown keys and values of the wrong kind, then Check()s.
 template <typename Options>
