@@ -1449,6 +1449,12 @@ TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
     "sequences": [{"name": "s", "preset": "sim-1", "simulate": )") + kTinySimulate + "}]}"));
   const EvaluationPlan plan = PlanEvaluation(manifest, {}, {ParseSweep("max_degree_D=4,8")}, folder / "out", folder / "cache");
   ASSERT_EQ(plan.runs.size(), 2u);
+  // A dry run lists what the evaluation would do.
+  const std::string before = DescribePlan(plan);
+  EXPECT_EQ(before.rfind("1 sequence(s) to render or import, 0 already in the cache; 2 run(s) to run, 0 finished", 0), 0u)
+      << before;
+  EXPECT_NE(before.find("to render     sim-1 "), std::string::npos) << before;
+  EXPECT_NE(before.find("to run        s [max_degree_D=8]\n"), std::string::npos) << before;
   std::vector<std::string> first_lines;
   ExecutePlan(plan, kPrograms, 2, [&](const std::string& line) { first_lines.push_back(line); });
   // Each run says how long it took; the first also how long the rest should take. (The
@@ -1464,6 +1470,11 @@ TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
   // As if the second run had been interrupted: only it runs again.
   std::filesystem::remove(plan.runs[1].run_folder / "summary.json");
   const auto untouched = std::filesystem::last_write_time(plan.runs[0].run_folder / "summary.json");
+  const std::string after = DescribePlan(plan);
+  EXPECT_EQ(after.rfind("0 sequence(s) to render or import, 1 already in the cache; 1 run(s) to run, 1 finished", 0), 0u)
+      << after;
+  EXPECT_NE(after.find("finished      s [max_degree_D=4]\n"), std::string::npos) << after;
+  EXPECT_NE(after.find("to run        s [max_degree_D=8]\n"), std::string::npos) << after;
   std::vector<std::string> lines;
   ExecutePlan(plan, kPrograms, 2, [&](const std::string& line) { lines.push_back(line); });
   ASSERT_EQ(lines.size(), 2u);

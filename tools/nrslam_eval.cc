@@ -121,6 +121,7 @@ int main(int argc, char** argv) {
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   double tolerance = 0.10;
   double run_timeout = 0;
+  bool dry_run = false;
   app.add_option("manifest", manifest_path, "manifest JSON (see data_manifests/)");
   app.add_option("--out", out, "result folder: runs/<sequence>[/<sweep point>], results.json, results.csv")
       ->capture_default_str();
@@ -143,6 +144,8 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds,
                  "render every preset of the manifest once per scene seed, e.g. --seeds 1-3 (names get -seedN; "
                  "the seed table summarises each preset over them)");
+  app.add_flag("--dry-run", dry_run,
+               "list the sequences it would render and the runs it would run (and which are done already), run nothing");
   app.add_option("--emit-jobs", emit_jobs, "write one shell command per run to FILE (for GNU parallel, Slurm) "
                                             "instead of running them");
   app.add_option("--check-baseline", check_baseline, "fail (exit 3) when a run is worse than this baseline file");
@@ -213,6 +216,10 @@ int main(int argc, char** argv) {
     if (manifest_path.empty()) throw nrslam::Error("a manifest is required (see data_manifests/)");
     const nrslam::Manifest manifest = LoadChosen(manifest_path, only, seeds);
     const nrslam::EvaluationPlan plan = nrslam::PlanEvaluation(manifest, resolved, grid, out, cache);
+    if (dry_run) {
+      std::cout << nrslam::DescribePlan(plan);
+      return 0;
+    }
     std::filesystem::create_directories(out);
     if (!emit_jobs.empty()) {
       std::ofstream file(emit_jobs);

@@ -210,6 +210,10 @@ ManifestSequence WithSimulatorPoint(ManifestSequence sequence, const std::vector
 
 }  // namespace
 
+std::string RunName(const std::string& sequence, const std::string& label) {
+  return label.empty() ? sequence : sequence + " [" + label + "]";
+}
+
 EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::string>& extra,
                               const std::vector<Sweep>& sweeps, const std::filesystem::path& out,
                               const std::filesystem::path& cache) {
@@ -402,6 +406,31 @@ bool RunIsFinished(const RunJob& run) {
   }
 }
 
+std::string DescribePlan(const EvaluationPlan& plan) {
+  std::ostringstream details;
+  int to_prepare = 0, finished = 0;
+  for (const PrepareJob& prepare : plan.prepares) {
+    const bool cached = std::filesystem::exists(prepare.folder);
+    to_prepare += !cached;
+    details << (cached ? "  in the cache  " : prepare.import ? "  to import     " : "  to render     ") << prepare.description;
+    for (size_t i = 0; i + 1 < prepare.arguments.size(); ++i) {
+      if (prepare.arguments[i] == "--set") details << ' ' << prepare.arguments[i + 1];  // what sets renders apart
+    }
+    details << "  " << prepare.folder.string() << '\n';
+  }
+  for (const RunJob& run : plan.runs) {
+    const bool done = RunIsFinished(run);
+    finished += done;
+    details << (done ? "  finished      " : "  to run        ") << RunName(run.sequence, run.label) << '\n';
+  }
+  std::ostringstream text;
+  text << to_prepare << " sequence(s) to render or import, " << plan.prepares.size() - to_prepare
+       << " already in the cache; " << plan.runs.size() - finished << " run(s) to run, " << finished
+       << " finished before (kept)\n"
+       << details.str();
+  return text.str();
+}
+
 void CheckRunProgramCode(const std::filesystem::path& run_program) {
   const std::optional<std::string> version = CommandOutput({run_program.string(), "--version"}, 5);
   if (!version) return;
@@ -505,7 +534,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   double run_seconds = 0;
   RunCommands(runs, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const RunJob& run = plan.runs[run_index[k]];
-    const std::string name = run.sequence + (run.label.empty() ? "" : " [" + run.label + "]");
+    const std::string name = RunName(run.sequence, run.label);
     const std::string counter = "[" + std::to_string(++finished) + "/" + std::to_string(runs.size()) + "] ";
     run_seconds += outcome.wall_seconds;
     if (outcome.ok() && RunIsFinished(run)) {

@@ -68,6 +68,9 @@ struct EvaluationPlan {
   std::vector<RunJob> runs;
 };
 
+// How messages and tables name a run: "sequence", or "sequence [sweep point]".
+std::string RunName(const std::string& sequence, const std::string& label);
+
 // Expands the manifest × the sweep grid (an external result is scored once, at no sweep point); `extra` assignments apply to every run (after the
 // manifest's). Validates every run's options.
 EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::string>& extra,
@@ -92,6 +95,11 @@ std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Pr
 // folder from other options (an --out reused after changing --set or the manifest) or other
 // code is run again rather than reported stale.
 bool RunIsFinished(const RunJob& run);
+
+// What ExecutePlan would do, for `nrslam_eval --dry-run`: a line counting the sequences to
+// render or import and those already in the cache, a line counting the runs to run and those
+// finished before (RunIsFinished), then one line per sequence and per run with its state.
+std::string DescribePlan(const EvaluationPlan& plan);
 
 // A run records the code fingerprint of the nrslam_run that made it, and RunIsFinished counts
 // it only when that is this program's. An nrslam_run built from other code (one tool rebuilt

@@ -72,7 +72,7 @@ std::vector<PlotSeries> TopView(const std::filesystem::path& estimate_file, cons
 // One run's section: plots and images, or why they are missing.
 std::string RunSection(const RunResult& result, const std::filesystem::path& folder) {
   std::ostringstream html;
-  const std::string key = result.sequence + (result.label.empty() ? "" : " [" + result.label + "]");
+  const std::string key = RunKey(result);
   html << "<section><h2 id=\"" << EscapeXml(Slug(result)) << "\">" << EscapeXml(key) << "</h2>\n";
   if (result.status == "failed") {
     html << "<p class=\"failed\">Failed: " << EscapeXml(result.error) << "</p></section>\n";
@@ -197,7 +197,8 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   std::vector<std::vector<std::string>> rows;
   for (const SweepValueSummary& summary : summaries) rows.push_back(SweepSummaryCells(summary));
   html << "<section><h2>Sweeps</h2><p>Per swept value, over the sequences tracked to the end at every point; "
-          "each run is also paired with the run of the same sequence at the option's default.</p>"
+          "each run is also paired with the run of the same sequence at a run option's default (the values "
+          "of a simulator option are different data, so they are not paired).</p>"
        << HtmlTable(SweepSummaryHeader(), rows);
   if (curves.empty()) return html.str() + "</section>\n";  // no numeric values to plot against
   html << "<p>RMSE of the runs that tracked every frame against each swept option, "
@@ -259,7 +260,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
   html << "<table><tr><th>run</th><th>status</th><th>init</th><th>tracked</th><th>RMSE mm</th><th>median mm</th>"
           "<th>flat mm</th><th>1 scale mm</th><th>ATE mm</th><th>fps</th><th>MB</th></tr>\n";
   for (const RunResult& r : results) {
-    const std::string key = r.sequence + (r.label.empty() ? "" : " [" + r.label + "]");
+    const std::string key = RunKey(r);
     html << "<tr><td><a href=\"#" << EscapeXml(Slug(r)) << "\">" << EscapeXml(key) << "</a></td>";
     if (r.status == "failed") {
       html << "<td class=\"failed\">FAILED</td><td colspan=\"9\" class=\"failed\">" << EscapeXml(r.error) << "</td></tr>\n";

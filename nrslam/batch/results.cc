@@ -114,7 +114,7 @@ std::string DescribeRevisions(const std::vector<RunResult>& results) {
 }
 
 std::string RunKey(const RunResult& result) {
-  return result.label.empty() ? result.sequence : result.sequence + " [" + result.label + "]";
+  return RunName(result.sequence, result.label);
 }
 
 void RmseChangeCounts::Add(double reference_mm, double rmse_mm) {
