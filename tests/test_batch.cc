@@ -966,6 +966,13 @@ TEST(SeedGroups, SummariseRunsThatDifferOnlyInTheSeed) {
       PlanEvaluation(manifest, {}, {ParseSweep("tracking.rigid=false,true")}, folder / "rigidity", folder / "cache"));
   ASSERT_GE(per_mode.size(), 2u);
   EXPECT_EQ(per_mode[1].name, "sim-3 [rigid=true]");
+  // A swept simulator option is named by the label alone, not again among the render's options.
+  const std::vector<SeedGroup> per_amplitude = GroupsOfFinishedRuns(PlanEvaluation(
+      manifest, {}, {ParseSweep("simulate.amplitude_mm=0,10")}, folder / "amplitude", folder / "cache"));
+  ASSERT_GE(per_amplitude.size(), 2u);
+  EXPECT_EQ(per_amplitude[0].name, "sim-3 [amplitude_mm=0]");
+  EXPECT_EQ(per_amplitude[0].sequences, (std::vector<std::string>{"a1", "a2", "a3", "a4"}));
+  EXPECT_EQ(per_amplitude[1].name, "sim-3 [amplitude_mm=10]");
 
   // Two groups that differ in a manifest option of their own are told apart by name.
   const Manifest two = LoadManifest(WriteFile(folder / "two.json", R"({"sequences": [

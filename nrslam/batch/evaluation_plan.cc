@@ -69,6 +69,8 @@ bool IsSimulatorAssignment(const std::string& assignment) {
   return assignment.compare(0, kSimulatorPrefix.size(), kSimulatorPrefix) == 0;
 }
 
+std::string SimulatorAssignment(const std::string& assignment) { return assignment.substr(kSimulatorPrefix.size()); }
+
 Sweep ParseSweep(const std::string& text) {
   const size_t equals = text.find('=');
   if (equals == std::string::npos || equals == 0 || equals + 1 == text.size()) {
@@ -196,7 +198,7 @@ int AddPrepare(const ManifestSequence& sequence, const std::filesystem::path& ca
 ManifestSequence WithSimulatorPoint(ManifestSequence sequence, const std::vector<std::string>& point) {
   for (const std::string& assignment : point) {
     if (!IsSimulatorAssignment(assignment)) continue;
-    const std::string simulator_assignment = assignment.substr(kSimulatorPrefix.size());
+    const std::string simulator_assignment = SimulatorAssignment(assignment);
     const std::string path = simulator_assignment.substr(0, simulator_assignment.find('=') + 1);  // "a.b="
     sequence.simulate.erase(std::remove_if(sequence.simulate.begin(), sequence.simulate.end(),
                                            [&](const std::string& a) { return a.compare(0, path.size(), path) == 0; }),

@@ -27,6 +27,9 @@ struct Sweep {
 Sweep ParseSweep(const std::string& text);
 // Whether a sweep point's "path=value" sets a simulator option ("simulate.…").
 bool IsSimulatorAssignment(const std::string& assignment);
+// Such an assignment as nrslam_simulate --set takes it: "simulate.deformation.amplitude_mm=5"
+// gives "deformation.amplitude_mm=5".
+std::string SimulatorAssignment(const std::string& assignment);
 
 // A simulator assignment that sets the scene seed: "seed=3".
 bool IsSeedAssignment(const std::string& assignment);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <set>
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/median.h"
@@ -33,12 +34,17 @@ std::string SeedOf(const std::vector<std::string>& arguments) {
   return "default";
 }
 
-// A render's description is its preset; its other settings follow the "--set"s.
+// A render's description is its preset; its other settings follow the "--set"s, but for those
+// of the sweep point, which its label names.
 std::string GroupName(const PrepareJob& render, const RunJob& run) {
+  std::set<std::string> swept;
+  for (const std::string& assignment : run.point) {
+    if (IsSimulatorAssignment(assignment)) swept.insert(SimulatorAssignment(assignment));
+  }
   std::string name = render.description;
   const std::vector<std::string> arguments = WithoutSeed(render.arguments);
   for (size_t i = 0; i + 1 < arguments.size(); ++i) {
-    if (arguments[i] == "--set") name += " " + arguments[i + 1];
+    if (arguments[i] == "--set" && swept.count(arguments[i + 1]) == 0) name += " " + arguments[i + 1];
   }
   const bool swept_rigidity = std::any_of(run.point.begin(), run.point.end(), [](const std::string& assignment) {
     return assignment.rfind("tracking.rigid=", 0) == 0;
