@@ -81,7 +81,7 @@ Sweep ParseSweep(const std::string& text) {
   std::string path;
   if (IsSimulatorAssignment(name)) {
     const std::string simulator_path =
-        ResolveOptionName(name.substr(kSimulatorPrefix.size()), simulator_paths, "--sweep: simulator option");
+        ResolveOptionName(SimulatorAssignment(name), simulator_paths, "--sweep: simulator option");
     // Seeds make renderings of the same scene family; they have their own flag and summary.
     if (simulator_path == "seed") throw Error("--sweep: sweep the scene seed with --seeds, e.g. --seeds 1-3");
     path = std::string(kSimulatorPrefix) + simulator_path;
