@@ -806,6 +806,36 @@ RunResult FinishedRun(const RunJob& run, const std::vector<double>& frame_rmse) 
   return result;
 }
 
+// Over a sweep the report plots how the rigid / deformable ratio moves with each numeric swept
+// value (the question a sweep of the data asks); a single value or a flag has no such plot.
+TEST(RigidComparison, TheReportPlotsTheRatioAgainstEachNumericSweptValue) {
+  const auto folder = UniqueTempFolder("rigid_ratio_plot");
+  const auto pair = [](const std::string& amplitude, const std::string& weighting, double deformable_mm,
+                       double rigid_mm) {
+    RigidComparison comparison;
+    for (RunResult* run : {&comparison.deformable, &comparison.rigid}) {
+      *run = Result(run == &comparison.rigid ? "s-rigid" : "s", run == &comparison.rigid ? rigid_mm : deformable_mm, 60);
+      run->frames_evaluated = 60;
+      run->point = {"simulate.deformation.amplitude_mm=" + amplitude, "deformation.weighting=" + weighting};
+      run->label = "amplitude_mm=" + amplitude + ",weighting=" + weighting;
+    }
+    return comparison;
+  };
+  const std::vector<RigidComparison> comparisons = {pair("0", "paper", 1.0, 0.5), pair("5", "paper", 2.0, 4.0)};
+  std::vector<RunResult> results;
+  for (const RigidComparison& comparison : comparisons) results.insert(results.end(), {comparison.deformable, comparison.rigid});
+  const auto page = [&](const std::vector<RigidComparison>& shown) {
+    WriteReport(results, shown, {}, folder / "report");
+    std::ifstream file(folder / "report" / "index.html");
+    return std::string((std::istreambuf_iterator<char>(file)), {});
+  };
+  const std::string html = page(comparisons);
+  EXPECT_NE(html.find("Rigid / deformable RMSE against amplitude_mm"), std::string::npos);
+  EXPECT_EQ(html.find("Rigid / deformable RMSE against weighting"), std::string::npos);  // not a number
+  EXPECT_EQ(page({comparisons[0]}).find("Rigid / deformable RMSE against"), std::string::npos);  // one value
+  std::filesystem::remove_all(folder);
+}
+
 TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
   const auto folder = UniqueTempFolder("rigid_pairs");
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [

@@ -2,8 +2,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <map>
+#include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -13,6 +16,7 @@
 #include "nrslam/eval/error_view.h"
 #include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
+#include "nrslam/util/json_options.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -158,6 +162,16 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
   return html.str();
 }
 
+// A sweep point's value as a number, for a plot's axis; nothing for a value that is not one
+// (a weighting's name, a flag).
+std::optional<double> NumericValue(const std::string& assignment) {
+  const std::string text = assignment.substr(assignment.find('=') + 1);
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0') return std::nullopt;
+  return value;
+}
+
 // A table of text cells, each escaped.
 std::string HtmlTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows) {
   std::ostringstream html;
@@ -180,14 +194,11 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   for (const RunResult& r : results) {
     if (r.status != "ok" || !r.evaluated()) continue;
     for (const std::string& assignment : r.point) {
-      const size_t equals = assignment.find('=');
-      try {
-        auto& cell = curves[assignment.substr(0, equals)][r.sequence][std::stod(assignment.substr(equals + 1))];
-        cell.first += r.rmse_mm;
-        cell.second += 1;
-      } catch (const std::exception&) {
-        // A non-numeric value (e.g. a weighting name) has no axis to plot on.
-      }
+      const std::optional<double> value = NumericValue(assignment);
+      if (!value) continue;  // no axis to plot it on
+      auto& cell = curves[assignment.substr(0, assignment.find('='))][r.sequence][*value];
+      cell.first += r.rmse_mm;
+      cell.second += 1;
     }
   }
   const std::vector<SweepValueSummary> summaries = SummariseSweep(results);
@@ -232,7 +243,37 @@ std::string RigidSection(const std::vector<RigidComparison>& comparisons) {
   std::vector<std::vector<std::string>> rows;
   for (const RigidComparison& comparison : comparisons) rows.push_back(RigidComparisonCells(comparison));
   html << HtmlTable(RigidComparisonHeader(), rows) << "<p>"
-       << EscapeXml(RigidComparisonTallyText(TallyRigidComparisons(comparisons))) << "</p></section>\n";
+       << EscapeXml(RigidComparisonTallyText(TallyRigidComparisons(comparisons))) << "</p>";
+  // With sweeps (of the data above all: where does the deformable model pay?), the ratio of the
+  // runs' own RMSEs against each swept value: option → value → log ratios of its pairs.
+  std::map<std::string, std::map<double, std::vector<double>>> log_ratios;
+  for (const RigidComparison& comparison : comparisons) {
+    if (comparison.deformable.rmse_mm <= 0 || comparison.rigid.rmse_mm <= 0) continue;
+    for (const std::string& assignment : comparison.deformable.point) {
+      const std::optional<double> value = NumericValue(assignment);
+      if (!value) continue;
+      log_ratios[assignment.substr(0, assignment.find('='))][*value].push_back(
+          std::log(comparison.rigid.rmse_mm / comparison.deformable.rmse_mm));
+    }
+  }
+  std::ostringstream plots;
+  for (const auto& [option, values] : log_ratios) {
+    if (values.size() < 2) continue;
+    PlotSeries ratio{"rigid / deformable", "#d62728", {}, {}, true};
+    for (const auto& [x, logs] : values) {
+      ratio.x.push_back(x);
+      ratio.y.push_back(std::exp(std::accumulate(logs.begin(), logs.end(), 0.0) / static_cast<double>(logs.size())));
+    }
+    const PlotSeries even{"equally accurate", "#999999", {ratio.x.front(), ratio.x.back()}, {1.0, 1.0}};
+    plots << LinePlotSvg({ratio, even}, {"Rigid / deformable RMSE against " + LastName(option), option, "ratio", 520, 300, false});
+  }
+  if (!plots.str().empty()) {
+    html << "<p>The ratio of each pair's own RMSEs against each swept option: the geometric mean over the pairs "
+            "at that value (with several options swept, over the others' values too). Above the grey line the "
+            "deformable runs are the more accurate.</p><div class=\"plots\">"
+         << plots.str() << "</div>";
+  }
+  html << "</section>\n";
   return html.str();
 }
 
