@@ -414,7 +414,8 @@ std::string DescribePlan(const EvaluationPlan& plan) {
   for (const PrepareJob& prepare : plan.prepares) {
     const bool cached = std::filesystem::exists(prepare.folder);
     to_prepare += !cached;
-    details << (cached ? "  in the cache  " : prepare.import ? "  to import     " : "  to render     ") << prepare.description;
+    details << (cached ? "  in the cache  " : prepare.import ? "  to import     " : "  to render     ")
+            << prepare.description;
     for (size_t i = 0; i + 1 < prepare.arguments.size(); ++i) {
       if (prepare.arguments[i] == "--set") details << ' ' << prepare.arguments[i + 1];  // what sets renders apart
     }

@@ -265,7 +265,8 @@ std::string RigidSection(const std::vector<RigidComparison>& comparisons) {
       ratio.y.push_back(std::exp(std::accumulate(logs.begin(), logs.end(), 0.0) / static_cast<double>(logs.size())));
     }
     const PlotSeries even{"equally accurate", "#999999", {ratio.x.front(), ratio.x.back()}, {1.0, 1.0}};
-    plots << LinePlotSvg({ratio, even}, {"Rigid / deformable RMSE against " + LastName(option), option, "ratio", 520, 300, false});
+    plots << LinePlotSvg({ratio, even},
+                         {"Rigid / deformable RMSE against " + LastName(option), option, "ratio", 520, 300, false});
   }
   if (!plots.str().empty()) {
     html << "<p>The ratio of each pair's own RMSEs against each swept option: the geometric mean over the pairs "
