@@ -26,6 +26,17 @@ namespace {
 // Sweep paths of simulator options start with this; the rest is nrslam_simulate's path.
 constexpr std::string_view kSimulatorPrefix = "simulate.";
 
+// `simulate` (a sequence's simulator assignments) with `assignment` ("path=value") in place of
+// any it had for that path, sorted, since the render's cache key is made from them in order.
+void OverrideAssignment(std::vector<std::string>* simulate, const std::string& assignment) {
+  const std::string path = assignment.substr(0, assignment.find('=') + 1);  // "a.b="
+  simulate->erase(std::remove_if(simulate->begin(), simulate->end(),
+                                 [&](const std::string& a) { return a.compare(0, path.size(), path) == 0; }),
+                  simulate->end());
+  simulate->push_back(assignment);
+  std::sort(simulate->begin(), simulate->end());
+}
+
 // FNV-1a: a cache key that is the same on every machine and build.
 std::string StableHash(const std::string& text) {
   uint64_t hash = 1469598103934665603ull;
@@ -150,10 +161,7 @@ Manifest WithSceneSeeds(const Manifest& manifest, const std::vector<uint64_t>& s
     for (const uint64_t seed : seeds) {
       ManifestSequence copy = sequence;
       copy.name += "-seed" + std::to_string(seed);
-      copy.simulate.erase(std::remove_if(copy.simulate.begin(), copy.simulate.end(), IsSeedAssignment),
-                          copy.simulate.end());
-      copy.simulate.push_back(Assignment("seed", Json(seed)));
-      std::sort(copy.simulate.begin(), copy.simulate.end());
+      OverrideAssignment(&copy.simulate, Assignment("seed", Json(seed)));
       add(copy);
     }
   }
@@ -197,15 +205,8 @@ int AddPrepare(const ManifestSequence& sequence, const std::filesystem::path& ca
 // `sequence` rendered with a sweep point's simulator assignments over its own.
 ManifestSequence WithSimulatorPoint(ManifestSequence sequence, const std::vector<std::string>& point) {
   for (const std::string& assignment : point) {
-    if (!IsSimulatorAssignment(assignment)) continue;
-    const std::string simulator_assignment = SimulatorAssignment(assignment);
-    const std::string path = simulator_assignment.substr(0, simulator_assignment.find('=') + 1);  // "a.b="
-    sequence.simulate.erase(std::remove_if(sequence.simulate.begin(), sequence.simulate.end(),
-                                           [&](const std::string& a) { return a.compare(0, path.size(), path) == 0; }),
-                            sequence.simulate.end());
-    sequence.simulate.push_back(simulator_assignment);
+    if (IsSimulatorAssignment(assignment)) OverrideAssignment(&sequence.simulate, SimulatorAssignment(assignment));
   }
-  std::sort(sequence.simulate.begin(), sequence.simulate.end());
   WithAssignments(SimPreset(sequence.preset), sequence.simulate);  // throws on a value out of range
   return sequence;
 }
