@@ -41,6 +41,16 @@ namespace {
 const Programs kPrograms{NRSLAM_TOOLS_DIR "/nrslam_simulate", NRSLAM_TOOLS_DIR "/nrslam_run",
                          NRSLAM_TOOLS_DIR "/nrslam_import", NRSLAM_TOOLS_DIR "/nrslam_eval"};
 
+// `action` must throw an Error whose message contains `message`.
+void ExpectRefused(const std::function<void()>& action, const std::string& message) {
+  try {
+    action();
+    ADD_FAILURE() << "accepted; expected: " << message;
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
+  }
+}
+
 std::filesystem::path WriteFile(const std::filesystem::path& file, const std::string& text) {
   std::filesystem::create_directories(file.parent_path());
   std::ofstream(file) << text;
@@ -262,12 +272,7 @@ TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
   // A value given twice would be two runs in one folder; one option swept twice (under any of
   // its names) would leave one sweep without effect.
   const auto refused = [&](const std::vector<Sweep>& grid, const std::string& message) {
-    try {
-      PlanEvaluation(manifest, {}, grid, folder / "out", folder / "cache");
-      ADD_FAILURE() << "accepted; expected: " << message;
-    } catch (const Error& error) {
-      EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
-    }
+    ExpectRefused([&] { PlanEvaluation(manifest, {}, grid, folder / "out", folder / "cache"); }, message);
   };
   refused({ParseSweep("k=1,2,1")}, "deformation.k: value 1 is given twice");
   refused({ParseSweep("k=1"), ParseSweep("deformation.k=2")}, "deformation.k is swept twice");
@@ -313,23 +318,18 @@ TEST(Sweep, SimulatorOptionsRenderThePresetsAnewPerValue) {
   EXPECT_EQ(plan.runs[1].point[0], "simulate.deformation.amplitude_mm=0");
   EXPECT_EQ(plan.runs[1].run_folder, std::filesystem::absolute(folder / "out" / "runs" / "s" / "amplitude_mm=0,k=2"));
 
-  const auto refused = [&](const std::function<void()>& plan_it, const std::string& message) {
-    try {
-      plan_it();
-      ADD_FAILURE() << "accepted; expected: " << message;
-    } catch (const Error& error) {
-      EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
-    }
-  };
-  refused([] { ParseSweep("simulate.amplitude=1,2"); }, "did you mean colon.bend_amplitude_mm or deformation.amplitude_mm?");
-  refused([] { ParseSweep("amplitude_mm=1,2"); }, "a simulator option; to render the presets anew for each value, sweep "
-                                                  "simulate.deformation.amplitude_mm");
-  refused([] { ParseSweep("simulate.seed=1,2"); }, "with --seeds");
-  refused([&] { PlanEvaluation(manifest, {}, {ParseSweep("simulate.amplitude_mm=5,40")}, folder / "out", folder / "cache"); },
-          "sequence 's' at amplitude_mm=40: simulate: sim deformation: amplitude_mm must be in [0, 30]");
+  ExpectRefused([] { ParseSweep("simulate.amplitude=1,2"); },
+                "did you mean colon.bend_amplitude_mm or deformation.amplitude_mm?");
+  ExpectRefused([] { ParseSweep("amplitude_mm=1,2"); },
+                "a simulator option; to render the presets anew for each value, sweep simulate.deformation.amplitude_mm");
+  ExpectRefused([] { ParseSweep("simulate.seed=1,2"); }, "with --seeds");
+  ExpectRefused(
+      [&] { PlanEvaluation(manifest, {}, {ParseSweep("simulate.amplitude_mm=5,40")}, folder / "out", folder / "cache"); },
+      "sequence 's' at amplitude_mm=40: simulate: sim deformation: amplitude_mm must be in [0, 30]");
   const Manifest on_disk = LoadManifest(WriteFile(folder / "d.json", R"({"sequences": [{"name": "d", "path": "seq"}]})"));
-  refused([&] { PlanEvaluation(on_disk, {}, {ParseSweep("simulate.amplitude_mm=5")}, folder / "out", folder / "cache"); },
-          "sequence 'd' is not rendered from a preset");
+  ExpectRefused(
+      [&] { PlanEvaluation(on_disk, {}, {ParseSweep("simulate.amplitude_mm=5")}, folder / "out", folder / "cache"); },
+      "sequence 'd' is not rendered from a preset");
   std::filesystem::remove_all(folder);
 }
 

@@ -101,10 +101,8 @@ Sweep ParseSweep(const std::string& text) {
       path = ResolveRunOption(name);
     } catch (const Error&) {
       // A simulator option given without its prefix gets the spelling that sweeps it.
-      const auto simulator = std::find_if(simulator_paths.begin(), simulator_paths.end(), [&](const std::string& p) {
-        return p == name || LastName(p) == name;
-      });
-      if (simulator == simulator_paths.end()) throw;
+      const std::optional<std::string> simulator = FindOptionName(name, simulator_paths);
+      if (!simulator) throw;
       throw Error("--sweep: '" + name + "' is a simulator option; to render the presets anew for each value, sweep " +
                   std::string(kSimulatorPrefix) + *simulator);
     }

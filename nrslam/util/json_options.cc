@@ -159,13 +159,28 @@ std::string UnknownOptionHint(const std::string& name, const std::vector<std::st
   return "did you mean " + (close.empty() ? last : Join(close, ", ") + " or " + last) + "?";
 }
 
-std::string ResolveOptionName(const std::string& name, const std::vector<std::string>& paths, const std::string& kind) {
-  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
+namespace {
+
+std::vector<std::string> PathsWithLastName(const std::string& name, const std::vector<std::string>& paths) {
   std::vector<std::string> matches;
   for (const std::string& path : paths) {
     if (LastName(path) == name) matches.push_back(path);
   }
+  return matches;
+}
+
+}  // namespace
+
+std::optional<std::string> FindOptionName(const std::string& name, const std::vector<std::string>& paths) {
+  if (std::find(paths.begin(), paths.end(), name) != paths.end()) return name;
+  const std::vector<std::string> matches = PathsWithLastName(name, paths);
   if (matches.size() == 1) return matches.front();
+  return std::nullopt;
+}
+
+std::string ResolveOptionName(const std::string& name, const std::vector<std::string>& paths, const std::string& kind) {
+  if (const std::optional<std::string> path = FindOptionName(name, paths)) return *path;
+  const std::vector<std::string> matches = PathsWithLastName(name, paths);
   if (matches.empty()) throw Error(kind + " '" + name + "' is unknown; " + UnknownOptionHint(name, paths));
   throw Error(kind + " '" + name + "' is ambiguous: " + Join(matches, ", "));
 }

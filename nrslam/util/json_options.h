@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,7 +54,9 @@ std::string LastName(const std::string& path);
 std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths);
 
 // `name` as one of `paths`: the path itself, or the only path whose last part it is ("k" for
-// "deformation.k"). Throws Error "<kind> 'name' is unknown; <hint>" or "... is ambiguous: a, b".
+// "deformation.k"); nothing when no path or several match.
+std::optional<std::string> FindOptionName(const std::string& name, const std::vector<std::string>& paths);
+// The same, throwing Error "<kind> 'name' is unknown; <hint>" or "... is ambiguous: a, b".
 std::string ResolveOptionName(const std::string& name, const std::vector<std::string>& paths, const std::string& kind);
 
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
