@@ -1004,6 +1004,63 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   fs::remove_all(folder);
 }
 
+std::vector<std::string> FileLines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// A damaged ground-truth depth map costs its frame the score and nothing else: the frame is
+// tracked as from the whole sequence, and the run, an external scoring of it and a comparison
+// all leave that frame out and say so. Where depth is the input (the map from depth), the frame
+// cannot start a map, and the next one does.
+TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
+  const fs::path folder = UniqueTempFolder("nrslam_unreadable_groundtruth");
+  fs::remove_all(folder);
+  SimulateSmall("sim-1", 10, 320, 240, folder / "whole");
+  fs::copy(folder / "whole", folder / "damaged", fs::copy_options::recursive);
+  fs::resize_file(folder / "damaged" / "depth" / "000006.png", 200);  // header intact, data cut
+  const RunSummary whole = RunSequence(folder / "whole", TrackingExperiment(), folder / "whole_run");
+  const RunSummary damaged = RunSequence(folder / "damaged", TrackingExperiment(), folder / "damaged_run");
+  EXPECT_EQ(damaged.frames_tracked, 10);
+  EXPECT_EQ(damaged.frames_lost, 0);
+  EXPECT_EQ(whole.frames_evaluated, 10);
+  EXPECT_EQ(damaged.frames_evaluated, 9);
+  EXPECT_EQ(whole.frames_groundtruth_unreadable, 0);
+  EXPECT_EQ(damaged.frames_groundtruth_unreadable, 1);
+  for (const char* file : {"trajectory.tum", "points.csv"}) {
+    EXPECT_EQ(FileLines(folder / "damaged_run" / file), FileLines(folder / "whole_run" / file)) << file;
+  }
+  const std::vector<std::string> metrics = FileLines(folder / "damaged_run" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 11u);
+  EXPECT_EQ(metrics[7].rfind("6,tracking,", 0), 0u) << metrics[7];
+  EXPECT_NE(metrics[7].find("not scored: cannot decode"), std::string::npos) << metrics[7];
+  EXPECT_NE(metrics[7].find("000006.png"), std::string::npos) << metrics[7];
+  EXPECT_EQ(ReadJsonFile(folder / "damaged_run" / "summary.json").at("frames_groundtruth_unreadable"), 1);
+  EXPECT_NE(DescribeSummary(damaged).find("ground-truth depth unreadable on 1 tracked frame"), std::string::npos)
+      << DescribeSummary(damaged);
+
+  ExternalResult external;
+  external.estimates = folder / "whole_run" / "points.csv";
+  external.trajectory = folder / "whole_run" / "trajectory.tum";
+  const RunSummary scored = ScoreExternalResult(folder / "damaged", external, EvaluationOptions{}, folder / "scored");
+  EXPECT_EQ(scored.frames_tracked, 10);
+  EXPECT_EQ(scored.frames_evaluated, 9);
+  EXPECT_EQ(scored.frames_groundtruth_unreadable, 1);
+  EXPECT_NEAR(scored.rmse_mm, damaged.rmse_mm, 1e-5);
+  EXPECT_EQ(CompareRunFolders(folder / "damaged_run", folder / "damaged_run").frames, 9);
+
+  fs::resize_file(folder / "damaged" / "depth" / "000000.png", 200);
+  const RunSummary late = RunSequence(folder / "damaged", TrackingExperiment(), folder / "late_run");
+  EXPECT_EQ(late.init_frame, 1);
+  EXPECT_EQ(late.frames_tracked, 9);
+  const std::vector<std::string> late_metrics = FileLines(folder / "late_run" / "metrics.csv");
+  ASSERT_EQ(late_metrics.size(), 11u);
+  EXPECT_NE(late_metrics[1].find("000000.png"), std::string::npos) << late_metrics[1];
+  fs::remove_all(folder);
+}
+
 // Lost in two black frames, the run starts a second map from depth once the view is back (the
 // `map` column counts 2 by the last frame). Each map numbers its points from 0; points.csv
 // numbers the second map's after the first's, so an id names one point of the run

@@ -142,9 +142,14 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
               "deep (full colour at the per cent given); beside it the ground-truth depth, each point filled with the "
               "colour of its own depth:</p><div class=\"images\">";
       for (int frame : shown) {
+        std::string depth_problem;
+        const cv::Mat depth_mm = sequence.TryReadDepthMm(frame, &depth_problem);
+        if (!depth_problem.empty()) {
+          html << "<p>frame " << frame << ": " << EscapeXml(depth_problem) << "</p>";
+          continue;
+        }
         const std::string name = Slug(result) + "_depth_error_" + std::to_string(frame) + ".png";
-        const ErrorView view = DrawErrorView(sequence.ReadRgb(frame), sequence.ReadDepthMm(frame), points[frame],
-                                             evaluation, view_options);
+        const ErrorView view = DrawErrorView(sequence.ReadRgb(frame), depth_mm, points[frame], evaluation, view_options);
         cv::imwrite((folder / name).string(), view.image);
         html << "<figure><img src=\"" << EscapeXml(name) << "\" width=\"640\"><figcaption>frame " << frame;
         if (view.evaluation.evaluated) {

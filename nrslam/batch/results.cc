@@ -43,6 +43,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->frames_total = json.value("frames_total", 0);
   // Results written before the field existed always had ground truth for every tracked frame.
   result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
+  result->frames_groundtruth_unreadable = json.value("frames_groundtruth_unreadable", 0);
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
   result->rmse_flat_mm = NumberOr(json, "rmse_flat_mm", -1.0);
@@ -284,7 +285,8 @@ Json ToJson(const std::vector<RunResult>& results) {
   for (const RunResult& r : results) {
     rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
-                    {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
+                    {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated},
+                    {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
                     {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
                     {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
                     {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
@@ -329,12 +331,12 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::filesystem::create_directories(folder);
   std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
   std::ofstream csv(folder / "results.csv");
-  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,rmse_mm,rmse_median_mm,"
+  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,frames_groundtruth_unreadable,rmse_mm,rmse_median_mm,"
          "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,"
          "birth_log_error_mean,birth_log_error_median,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
-        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.frames_groundtruth_unreadable << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
@@ -374,6 +376,9 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   for (const RunResult& r : results) {
     if (r.status == "failed") out << "FAILED " << RunKey(r) << ": " << r.error << '\n';
     if (!StopText(r).empty()) out << RunKey(r) << ": " << StopText(r) << '\n';
+    if (r.frames_groundtruth_unreadable > 0) {
+      out << RunKey(r) << ": " << UnreadableGroundTruthText(r.frames_groundtruth_unreadable) << '\n';
+    }
   }
   if (!swept) return;
   const std::vector<SweepValueSummary> values = SummariseSweep(results);

@@ -79,8 +79,12 @@ CommonPointsComparison CompareRunFolders(const std::filesystem::path& a, const s
   const SequenceReader reader(sequence);
   if (!reader.has_depth()) throw Error("sequence " + sequence + " has no depth to compare against");
   // Scored as run a scored itself.
-  return CompareOnCommonPoints(ReadRunPoints(a), ReadRunPoints(b), [&](int frame) { return reader.ReadDepthMm(frame); },
-                               RunEvaluationOptions(a));
+  // A frame whose ground truth cannot be read was scored in neither run: it is left out here too.
+  const auto depth_mm = [&](int frame) {
+    std::string problem;
+    return reader.TryReadDepthMm(frame, &problem);
+  };
+  return CompareOnCommonPoints(ReadRunPoints(a), ReadRunPoints(b), depth_mm, RunEvaluationOptions(a));
 }
 
 }  // namespace nrslam

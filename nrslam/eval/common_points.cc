@@ -62,6 +62,7 @@ CommonPointsComparison CompareOnCommonPoints(const RunPoints& a, const RunPoints
       common_b.push_back(match->second);
     }
     const cv::Mat depth = depth_mm(frame);
+    if (depth.empty()) continue;
     const FrameEvaluation evaluations[] = {EvaluateFrame(Values(points), depth, options),
                                            EvaluateFrame(Values(other->second), depth, options),
                                            EvaluateFrame(common_a, depth, options),

@@ -36,10 +36,10 @@ struct CommonPointsComparison {
 // How far apart (pixels) two runs may first report an id for it to be the same point.
 constexpr double kSameTrackPixels = 0.5;
 
-// `depth_mm(frame)` gives a frame's ground truth (CV_32F, 0 = none). A point is common when
-// both runs report its id and first reported that id in the same frame at the same pixel: the
-// same track, as when one initial map (from depth, or the same two-view map) is tracked in two
-// modes. Ids that fail the check are counted, not compared.
+// `depth_mm(frame)` gives a frame's ground truth (CV_32F, 0 = none; an empty matrix leaves the
+// frame out). A point is common when both runs report its id and first reported that id in the
+// same frame at the same pixel: the same track, as when one initial map (from depth, or the same
+// two-view map) is tracked in two modes. Ids that fail the check are counted, not compared.
 CommonPointsComparison CompareOnCommonPoints(const RunPoints& a, const RunPoints& b,
                                              const std::function<cv::Mat(int frame)>& depth_mm,
                                              const EvaluationOptions& options);

@@ -163,6 +163,16 @@ cv::Mat SequenceReader::ReadDepthMm(int index) const {
   return DecodeDepthMm(ReadImage("depth", index, cv::IMREAD_UNCHANGED, CV_16UC1), info_.depth_unit_mm);
 }
 
+cv::Mat SequenceReader::TryReadDepthMm(int index, std::string* problem) const {
+  problem->clear();
+  try {
+    return ReadDepthMm(index);
+  } catch (const Error& e) {
+    *problem = e.what();
+    return cv::Mat();
+  }
+}
+
 cv::Mat SequenceReader::ReadMask(int index) const {
   cv::Mat mask = fixed_mask_.clone();
   if (has_frame_masks_) {

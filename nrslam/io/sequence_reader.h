@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "nrslam/io/sequence_info.h"
@@ -30,6 +31,9 @@ class SequenceReader {
 
   cv::Mat ReadRgb(int index) const;      // CV_8UC3, BGR
   cv::Mat ReadDepthMm(int index) const;  // CV_32F millimetres, 0 = no ground truth
+  // The same for scoring, where one damaged ground-truth file should cost its frame's score and
+  // not the run: an empty matrix, with `*problem` saying why, when the file cannot be read.
+  cv::Mat TryReadDepthMm(int index, std::string* problem) const;
   cv::Mat ReadRight(int index) const;    // CV_8UC3
   // Validity mask for a frame: the fixed mask AND the frame's mask; empty if neither exists.
   cv::Mat ReadMask(int index) const;

@@ -253,6 +253,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     const auto pose = poses.find(frame);
     const bool tracked = !points.empty() || pose != poses.end();
     FrameEvaluation frame_evaluation;
+    std::string depth_problem;  // why a tracked frame with points is not scored
     if (tracked && summary.init_frame < 0) {
       summary.init_frame = frame;
       summary.maps = 1;  // one map: another system's figures are not split by its re-initialisations
@@ -263,8 +264,12 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
       for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
       cv::Mat depth_mm;
       if (reader.has_depth() && !points.empty()) {
-        depth_mm = reader.ReadDepthMm(frame);
-        frame_evaluation = EvaluateFrame(depth_points, depth_mm, evaluation);
+        depth_mm = reader.TryReadDepthMm(frame, &depth_problem);
+        if (depth_problem.empty()) {
+          frame_evaluation = EvaluateFrame(depth_points, depth_mm, evaluation);
+        } else {
+          ++summary.frames_groundtruth_unreadable;
+        }
       }
       if (ids_name_points) {
         std::vector<int64_t> ids;
@@ -304,7 +309,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << (frame_evaluation.evaluated ? frame_evaluation.scale : 0.0) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
-                << ",0,0,0,0,0,0,0,0,\"" << (tracked ? "" : "no estimate") << "\"\n";
+                << ",0,0,0,0,0,0,0,0,\"" << (!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem)
+                << "\"\n";
     // Last used here, so its pairs move into the list kept for the alignments at the end.
     if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }

@@ -17,6 +17,11 @@ std::string DescribeStop(int init_frame, int stop_frame, const std::string& reas
   return "lost from frame " + std::to_string(stop_frame) + ": " + reason;
 }
 
+std::string UnreadableGroundTruthText(int frames) {
+  return "ground-truth depth unreadable on " + std::to_string(frames) + " tracked frame" + (frames == 1 ? "" : "s") +
+         ", not scored; metrics.csv names the files";
+}
+
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
   return stop_frame >= 0 ? "lost" : "ok";
@@ -56,6 +61,9 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
+  if (summary.frames_groundtruth_unreadable > 0) {
+    text << '\n' << UnreadableGroundTruthText(summary.frames_groundtruth_unreadable);
+  }
   return text.str();
 }
 
@@ -134,6 +142,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_total", summary.frames_total},
                       {"frames_lost", summary.frames_lost},
                       {"frames_evaluated", summary.frames_evaluated},
+                      {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},
                       {"peak_memory_mb", summary.peak_memory_mb > 0 ? nlohmann::json(summary.peak_memory_mb) : nlohmann::json()},

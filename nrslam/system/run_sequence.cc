@@ -49,13 +49,16 @@ void WritePly(const fs::path& path, const Map& map) {
 
 struct FrameImages {
   cv::Mat bgr, mask, depth_mm;
+  std::string depth_problem;  // why depth_mm is empty although the sequence has depth
 };
 
+// An unreadable colour image or mask makes the frame unusable (thrown); an unreadable depth map
+// only matters where depth is used, so it is reported beside the frame instead.
 FrameImages ReadFrame(const SequenceReader& reader, int frame) {
   FrameImages images;
   images.bgr = reader.ReadRgb(frame);
   images.mask = reader.ReadMask(frame);
-  if (reader.has_depth()) images.depth_mm = reader.ReadDepthMm(frame);
+  if (reader.has_depth()) images.depth_mm = reader.TryReadDepthMm(frame, &images.depth_problem);
   return images;
 }
 
@@ -150,11 +153,13 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     result.frame = frame;
     MappingReport mapping;
     cv::Mat depth_mm;
+    std::string depth_problem;
     try {
       const FrameImages images = io.Take(frame);
       const cv::Mat& bgr = images.bgr;
       const cv::Mat& mask = images.mask;
       depth_mm = images.depth_mm;
+      depth_problem = images.depth_problem;
       if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask);
         if (result.state == TrackingState::kLost) {
@@ -198,6 +203,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
           }
         }
       } else {
+        if (!depth_problem.empty()) throw Error(depth_problem);
         result = tracker.InitialiseFromDepth(frame, bgr, depth_mm, mask);
         if (result.state == TrackingState::kTracking) {
           start_map(result, std::nullopt);
@@ -217,6 +223,12 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     FrameEvaluation evaluation;
     std::vector<DepthPoint> depth_points;
     const bool tracked = result.state == TrackingState::kTracking;
+    if (tracked && !depth_problem.empty()) {
+      // Tracked as if it were whole: only its score is missing, and the run says so.
+      ++summary.frames_groundtruth_unreadable;
+      result.note = "not scored: " + depth_problem;
+      log << "frame " << frame << ": " << result.note << '\n';
+    }
     if (tracked) {
       trajectory.push_back({frame / reader.info().fps, result.cam_from_world.Inverse()});
       if (reader.has_groundtruth()) {
