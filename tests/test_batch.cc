@@ -1366,6 +1366,52 @@ TEST(Tools, ProgressIntoALogFileIsWholeLines) {
   std::filesystem::remove_all(folder);
 }
 
+// One damaged file costs a preview video only its frame: an unreadable colour image becomes a
+// black frame (a folder of PNGs leaves it out), an unreadable depth map a view without ground
+// truth, and both are named on stderr; a single frame that cannot be drawn is still an error.
+TEST(Tools, PreviewOfADamagedSequenceSkipsOnlyTheDamagedFrames) {
+  const auto folder = UniqueTempFolder("tool_preview_damaged");
+  std::filesystem::create_directories(folder);
+  const std::filesystem::path sequence = folder / "seq";
+  const auto [rendered, render_log] = RunCaught(kPrograms.simulate.string() +
+                                                    " --preset sim-0 --frames 6 --width 160 --height 120 --quiet --out " +
+                                                    sequence.string(),
+                                                folder / "render.txt");
+  ASSERT_EQ(rendered, 0) << render_log;
+  std::filesystem::resize_file(sequence / "rgb" / "000002.png", 200);    // header intact, data cut
+  std::filesystem::resize_file(sequence / "depth" / "000004.png", 200);
+  const std::string preview = NRSLAM_TOOLS_DIR "/nrslam_preview " + sequence.string();
+  const std::filesystem::path video = folder / "view.avi";
+  const auto [drawn, draw_log] = RunCaught(preview + " --all --out " + video.string(), folder / "video.txt");
+  ASSERT_EQ(drawn, 0) << draw_log;
+  EXPECT_NE(draw_log.find("frame 2: cannot decode"), std::string::npos) << draw_log;
+  EXPECT_NE(draw_log.find("frame 4: cannot decode"), std::string::npos) << draw_log;
+  EXPECT_NE(draw_log.find("drawn without ground truth"), std::string::npos) << draw_log;
+  EXPECT_NE(draw_log.find("wrote 6 frames to " + video.string() + " (1 unreadable: black)"), std::string::npos)
+      << draw_log;
+  cv::VideoCapture capture(video.string());
+  ASSERT_TRUE(capture.isOpened());
+  std::vector<double> brightness;
+  for (cv::Mat image; capture.read(image);) {
+    EXPECT_EQ(image.size(), cv::Size(320, 120));  // colour | depth, every frame
+    brightness.push_back(cv::mean(image)[0]);
+  }
+  ASSERT_EQ(brightness.size(), 6u);
+  EXPECT_LT(brightness[2], 2.0);  // the unreadable colour image: black (up to JPEG's ringing)
+  for (size_t frame : {0u, 1u, 3u, 4u, 5u}) EXPECT_GT(brightness[frame], 10.0) << frame;
+  const auto [folder_drawn, folder_log] =
+      RunCaught(preview + " --all --out " + (folder / "frames").string(), folder / "frames.txt");
+  ASSERT_EQ(folder_drawn, 0) << folder_log;
+  for (int frame = 0; frame < 6; ++frame) {
+    EXPECT_EQ(std::filesystem::exists(folder / "frames" / FrameFileName(frame)), frame != 2) << frame;
+  }
+  const auto [single, single_log] =
+      RunCaught(preview + " --frame 2 --out " + (folder / "one.png").string(), folder / "one.txt");
+  EXPECT_NE(single, 0);
+  EXPECT_NE(single_log.find("cannot decode"), std::string::npos) << single_log;
+  std::filesystem::remove_all(folder);
+}
+
 TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   const auto folder = UniqueTempFolder("batch_crash");
   EvaluationPlan plan;

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -98,7 +99,16 @@ class Preview {
 
   cv::Mat Draw(int frame) const {
     const cv::Mat colour = reader_.ReadRgb(frame);
-    const cv::Mat depth = reader_.has_depth() ? reader_.ReadDepthMm(frame) : cv::Mat();
+    cv::Mat depth;
+    if (reader_.has_depth()) {
+      std::string problem;
+      depth = reader_.TryReadDepthMm(frame, &problem);
+      if (!problem.empty()) {
+        // Drawn as no ground truth (black), so the frame keeps the size of the others.
+        std::cerr << "nrslam_preview: frame " << frame << ": " << problem << "; drawn without ground truth\n";
+        depth = cv::Mat::zeros(colour.size(), CV_32F);
+      }
+    }
     if (runs_.empty()) {
       cv::Mat panel = colour;
       if (!depth.empty()) cv::hconcat(colour, nrslam::ColourDepth(depth, options_.near_mm, options_.far_mm), panel);
@@ -144,6 +154,17 @@ class Preview {
   double scale_;
 };
 
+// A frame of --all, or nothing (said on stderr) when its colour image cannot be read: one
+// damaged frame should not cost the rest of a video.
+std::optional<cv::Mat> DrawOrSkip(const Preview& preview, int frame) {
+  try {
+    return preview.Draw(frame);
+  } catch (const nrslam::Error& e) {
+    std::cerr << "nrslam_preview: frame " << frame << ": " << e.what() << "; skipped\n";
+    return std::nullopt;
+  }
+}
+
 void WritePng(const fs::path& file, const cv::Mat& image) {
   if (!cv::imwrite(file.string(), image)) throw nrslam::Error("cannot write " + file.string());
 }
@@ -184,26 +205,43 @@ int main(int argc, char** argv) {
       WritePng(out, preview.Draw(frame));
       return 0;
     }
+    int skipped = 0;  // frames whose colour image could not be read
     if (fs::path(out).extension() == ".avi") {
       // Motion JPEG: OpenCV writes it without any external codec.
+      // A skipped frame is a black one, so the video keeps the sequence's timing; those before
+      // the first drawn frame wait for its size.
       cv::VideoWriter video;
+      cv::Size size;
+      int black_frames = 0;
       for (int index = 0; index < preview.frame_count(); ++index) {
-        const cv::Mat image = preview.Draw(index);
-        if (!video.isOpened() &&
-            !video.open(out, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), preview.fps(), image.size())) {
-          throw nrslam::Error("cannot write the video " + out);
+        const std::optional<cv::Mat> image = DrawOrSkip(preview, index);
+        skipped += !image;
+        if (!image) ++black_frames;
+        if (image && !video.isOpened()) {
+          size = image->size();
+          if (!video.open(out, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), preview.fps(), size)) {
+            throw nrslam::Error("cannot write the video " + out);
+          }
         }
-        video.write(image);
+        if (!video.isOpened()) continue;
+        for (; black_frames > 0; --black_frames) video.write(cv::Mat(size, CV_8UC3, cv::Scalar::all(0)));
+        if (image) video.write(*image);
       }
+      if (!video.isOpened()) throw nrslam::Error("no frame of the sequence could be drawn");
     } else {
       fs::create_directories(out);
       for (int index = 0; index < preview.frame_count(); ++index) {
         char name[16];
         std::snprintf(name, sizeof(name), "%06d.png", index);
-        WritePng(fs::path(out) / name, preview.Draw(index));
+        const std::optional<cv::Mat> image = DrawOrSkip(preview, index);
+        skipped += !image;
+        if (image) WritePng(fs::path(out) / name, *image);
       }
     }
-    std::cout << "wrote " << preview.frame_count() << " frames to " << out << '\n';
+    const bool video = fs::path(out).extension() == ".avi";
+    std::cout << "wrote " << preview.frame_count() - (video ? 0 : skipped) << " frames to " << out;
+    if (skipped > 0) std::cout << " (" << skipped << " unreadable: " << (video ? "black" : "left out") << ")";
+    std::cout << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_preview: " << e.what() << '\n';
     return 1;
