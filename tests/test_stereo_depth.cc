@@ -2,11 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <iterator>
 
 #include "nrslam/datasets/stereo_depth.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -79,6 +82,19 @@ TEST(StereoDepth, ToolWritesTheSequencesDepth) {
   ASSERT_GT(errors.size(), 3u * 320 * 240 / 2);
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
   EXPECT_LT(errors[errors.size() / 2], 0.6);  // half the resolution of the test above: coarser
+  // A damaged image costs its frame's depth only: that frame gets none (0), the others theirs,
+  // sequence.json names it, and the replaced depth leaves nothing half-done behind.
+  std::filesystem::resize_file(folder / "seq" / "right" / "000001.png", 200);  // header intact, data cut
+  ASSERT_EQ(std::system((tools + "/nrslam_stereo_gt --quiet --overwrite " + (folder / "seq").string() +
+                         " > /dev/null 2>&1").c_str()),
+            0);
+  const SequenceReader redone(folder / "seq");
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(cv::countNonZero(redone.ReadDepthMm(i)) == 0, i == 1) << i;
+  }
+  EXPECT_EQ(ReadJsonFile(folder / "seq" / "sequence.json")["provenance"]["depth"]["frames_without_input"],
+            nlohmann::json::array({1}));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder / "seq"), {}), 5);  // no staging folder left
   // A mono sequence is refused with a message, not a crash.
   ASSERT_EQ(std::system((tools + "/nrslam_simulate --preset sim-0 --frames 2 --width 160 --height 120 --quiet --out " +
                          (folder / "mono").string() + " > /dev/null").c_str()),

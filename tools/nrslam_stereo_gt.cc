@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <vector>
 
 #include "nrslam/datasets/stereo_depth.h"
 #include "nrslam/io/sequence_reader.h"
@@ -12,6 +13,8 @@
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/progress_line.h"
 #include "nrslam/util/source_revision.h"
+
+namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   CLI::App app{"Depth ground truth from the rectified stereo pairs of a sequence"};
@@ -25,6 +28,7 @@ int main(int argc, char** argv) {
   app.add_flag("--overwrite", overwrite, "replace an existing depth/");
   app.add_flag("--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
+  fs::path staging;  // where the depth is written until it is whole
   try {
     const nrslam::StereoDepthOptions options = nrslam::WithAssignments(nrslam::StereoDepthOptions{}, assignments);
     const nrslam::SequenceReader sequence(folder);
@@ -35,18 +39,44 @@ int main(int argc, char** argv) {
     nrslam::SequenceInfo info = sequence.info();
     info.provenance["depth"] = {{"generator", std::string("nrslam_stereo_gt ") + NRSLAM_VERSION},
                                 {"options", nrslam::Json(options)}};
-    const nrslam::SequenceWriter writer(folder, info, true, nrslam::SequenceWriter::Target::kExistingSequence);
+    // The depth is written beside the sequence and swapped in whole at the end, so a run that
+    // stops early leaves the sequence as it was (with --overwrite, its old depth too).
+    staging = fs::path(folder) / ".stereo_gt_in_progress";
+    fs::remove_all(staging);
+    const nrslam::SequenceWriter staged(staging, info, true);
     nrslam::ProgressLine progress = nrslam::ProgressLine::OnStderr();
+    std::vector<int> unreadable;  // frames whose pair could not be read: no depth (0) there
+    const cv::Mat no_depth = cv::Mat::zeros(info.camera.height(), info.camera.width(), CV_32F);
     for (int i = 0; i < sequence.frame_count(); ++i) {
-      writer.WriteDepthMm(i, nrslam::StereoDepthMm(sequence.ReadRgb(i), sequence.ReadRight(i), info.camera.fx(),
-                                                   info.stereo->baseline_mm, options));
+      cv::Mat depth_mm;
+      try {
+        depth_mm = nrslam::StereoDepthMm(sequence.ReadRgb(i), sequence.ReadRight(i), info.camera.fx(),
+                                         info.stereo->baseline_mm, options);
+      } catch (const nrslam::Error& e) {
+        std::cerr << "nrslam_stereo_gt: frame " << i << ": " << e.what() << "; written without depth\n";
+        unreadable.push_back(i);
+        depth_mm = no_depth;
+      }
+      staged.WriteDepthMm(i, depth_mm);
       if (!quiet) {
         progress.Update("depth " + std::to_string(i + 1) + "/" + std::to_string(sequence.frame_count()),
                         i + 1 == sequence.frame_count());
       }
     }
-    std::cout << "wrote depth for " << sequence.frame_count() << " frames into " << folder << "/depth\n";
+    if (!unreadable.empty()) info.provenance["depth"]["frames_without_input"] = unreadable;
+    fs::remove_all(fs::path(folder) / "depth");
+    fs::rename(staging / "depth", fs::path(folder) / "depth");
+    nrslam::SequenceWriter(folder, info, true, nrslam::SequenceWriter::Target::kExistingSequence);  // sequence.json
+    fs::remove_all(staging);
+    std::cout << "wrote depth for " << sequence.frame_count() << " frames into " << folder << "/depth";
+    if (!unreadable.empty()) {
+      std::cout << " (" << unreadable.size() << " without depth: their images could not be read; sequence.json "
+                << "lists them under provenance.depth.frames_without_input)";
+    }
+    std::cout << '\n';
   } catch (const std::exception& e) {
+    std::error_code ignored;
+    if (!staging.empty()) fs::remove_all(staging, ignored);
     std::cerr << "nrslam_stereo_gt: " << e.what() << '\n';
     return 1;
   }
