@@ -241,6 +241,15 @@ TEST(DatasetImport, PlainImageFolderAndVideoWithACalibration) {
   options.calibration = in / "wrong.json";
   fs::remove_all(out);
   EXPECT_NE(ImportError(options, out).find("is 64x48 but the camera is 640x480"), std::string::npos);
+  // A failed import leaves no half sequence behind (it would pass for a whole one until read):
+  // here a frame whose file is cut short.
+  EXPECT_FALSE(fs::exists(out / "sequence.json"));
+  options.input = in / "frames";
+  options.calibration = in / "camera.json";
+  fs::resize_file(in / "frames" / "f1.jpg", 100);
+  EXPECT_NE(ImportError(options, out).find("cannot read " + (in / "frames" / "f1.jpg").string()), std::string::npos);
+  EXPECT_FALSE(fs::exists(out / "sequence.json"));
+  EXPECT_FALSE(fs::exists(out / "rgb"));
   options.format = "hamlin";
   EXPECT_NE(ImportError(options, out).find("unknown dataset format 'hamlin'"), std::string::npos);
   fs::remove_all(in);

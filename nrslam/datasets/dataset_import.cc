@@ -261,6 +261,30 @@ FrameSource Images(const ImportOptions& options) {
   return source;
 }
 
+// Every frame of `source` up to `count`, and its poses, into `writer`.
+void WriteFrames(const ImportOptions& options, const FrameSource& source, int count, const SequenceWriter& writer) {
+  const cv::Size size(source.camera.width(), source.camera.height());
+  for (int i = 0; i < count; ++i) {
+    const cv::Mat rgb = source.rgb(i);
+    if (rgb.size() != size) {
+      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
+                        " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    }
+    writer.WriteRgb(i, rgb);
+    if (source.right) writer.WriteRight(i, source.right(i));
+    if (source.depth_mm) {
+      const cv::Mat depth = source.depth_mm(i);
+      if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(i) + " has another size than the image");
+      writer.WriteDepthMm(i, depth);
+    }
+  }
+  if (!source.world_from_camera.empty()) {
+    std::vector<StampedPose> poses;
+    for (int i = 0; i < count; ++i) poses.push_back({i / options.fps, source.world_from_camera[i]});
+    writer.WriteGroundtruth(poses);
+  }
+}
+
 }  // namespace
 
 void ImportOptions::Check() const {
@@ -297,25 +321,17 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
                      {"format", options.format},
                      {"source", fs::absolute(options.input).string()}};
   const SequenceWriter writer(out, info, static_cast<bool>(source.depth_mm));
-  const cv::Size size(source.camera.width(), source.camera.height());
-  for (int i = 0; i < count; ++i) {
-    const cv::Mat rgb = source.rgb(i);
-    if (rgb.size() != size) {
-      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
-                        " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
+  try {
+    WriteFrames(options, source, count, writer);
+  } catch (...) {
+    // Half a sequence would pass for a whole one until its missing frames are read: a failed
+    // import leaves none.
+    try {
+      RemoveSequence(out);
+    } catch (const Error&) {
+      // The import's own error says more than a failed clean-up.
     }
-    writer.WriteRgb(i, rgb);
-    if (source.right) writer.WriteRight(i, source.right(i));
-    if (source.depth_mm) {
-      const cv::Mat depth = source.depth_mm(i);
-      if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(i) + " has another size than the image");
-      writer.WriteDepthMm(i, depth);
-    }
-  }
-  if (!source.world_from_camera.empty()) {
-    std::vector<StampedPose> poses;
-    for (int i = 0; i < count; ++i) poses.push_back({i / options.fps, source.world_from_camera[i]});
-    writer.WriteGroundtruth(poses);
+    throw;
   }
   return info;
 }
