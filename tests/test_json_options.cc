@@ -61,6 +61,13 @@ TEST(JsonOptions, UnknownNamesSuggestTheCloseOptions) {
 TEST(JsonOptions, BadValuesAndInvalidResultsAreRejected) {
   EXPECT_THROW(WithAssignments(SimOptions{}, {"frames=many"}), Error);
   EXPECT_THROW(WithAssignments(SimOptions{}, {"frames"}), Error);
+  try {
+    WithAssignments(SimOptions{}, {"frames=2.5"});  // would be truncated
+    ADD_FAILURE() << "frames=2.5 accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot use '2.5' (expected a whole number, like"), std::string::npos)
+        << e.what();
+  }
   // No Check() involved: JSON cannot hold these, so config.json would record null.
   for (const char* not_finite : {"inf", "-inf", "nan", "infinity"}) {
     Json config = {{"k", 1.1}};
