@@ -10,18 +10,12 @@
 
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/csv.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
-
-std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
 
 namespace {
 

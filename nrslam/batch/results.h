@@ -45,9 +45,6 @@ struct RunResult {
   bool complete() const { return status == "ok" && evaluated(); }
 };
 
-// `text` as one CSV field: quoted when it holds a comma, a quote or a line break.
-std::string CsvField(const std::string& text);
-
 // How tables and baselines name a run: "sequence", or "sequence [sweep point]".
 std::string RunKey(const RunResult& result);
 // The distinct revisions that made `revisions` (RunResult::revision; "" = not recorded), sorted

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "nrslam/batch/run_folder.h"
+#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/text_table.h"
 

@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <fstream>
-#include <sstream>
 
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/system/system_options.h"
+#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
 
@@ -14,21 +14,20 @@ namespace nrslam {
 std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file) {
   std::ifstream stream(file);
   if (!stream) throw Error("cannot read " + file.string());
-  std::vector<std::string> header;
+  std::vector<std::string> header, fields;
   std::vector<std::map<std::string, std::string>> rows;
-  std::string line;
-  while (std::getline(stream, line)) {
-    std::vector<std::string> fields;
-    std::stringstream split(line);
-    std::string field;
-    while (std::getline(split, field, ',')) fields.push_back(field);
-    if (header.empty()) {
-      header = fields;
-      continue;
+  int line = 0;
+  if (!ReadCsvRecord(stream, file.string(), &line, &header)) return rows;
+  while (ReadCsvRecord(stream, file.string(), &line, &fields)) {
+    if (fields.size() == 1 && fields[0].empty()) continue;  // a blank line
+    // Every row of a file nrslam wrote has the header's fields: fewer or more is damage.
+    if (fields.size() != header.size()) {
+      throw Error(file.string() + ":" + std::to_string(line) + ": " + std::to_string(fields.size()) +
+                  " fields where the header has " + std::to_string(header.size()) + " (a damaged or cut-short file?)");
     }
     std::map<std::string, std::string> row;
-    for (size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
-    rows.push_back(row);
+    for (size_t i = 0; i < header.size(); ++i) row[header[i]] = fields[i];
+    rows.push_back(std::move(row));
   }
   return rows;
 }

@@ -11,7 +11,8 @@
 
 namespace nrslam {
 
-// Rows of one of the runner's CSV files by column name (no quoted commas but in `note`).
+// Rows of a CSV file nrslam wrote (a run's points.csv or metrics.csv, an evaluation's tables) by
+// column name. Throws Error, naming the line, when a row has more or fewer fields than the header.
 std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file);
 // A row's field as a number; NaN when missing, empty or not a number.
 double Number(const std::map<std::string, std::string>& row, const std::string& key);

@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/text_table.h"

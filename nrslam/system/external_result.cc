@@ -17,6 +17,7 @@
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
 #include "nrslam/tracking/tracker.h"
+#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 
 namespace nrslam {
@@ -29,16 +30,6 @@ struct EstimatedPoint {
   double depth;
 };
 using FrameEstimates = std::map<int, std::vector<EstimatedPoint>>;
-
-std::vector<std::string> SplitCsvLine(std::string line) {
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  std::vector<std::string> fields;
-  std::stringstream stream(line);
-  std::string field;
-  while (std::getline(stream, field, ',')) fields.push_back(field);
-  if (!line.empty() && line.back() == ',') fields.emplace_back();
-  return fields;
-}
 
 // The whole field as a number, or nullopt ("nan" and "inf" parse: they are estimates a system
 // failed to make, not a malformed file).
@@ -64,10 +55,10 @@ void CheckFrame(double frame, int frame_count, const std::string& where) {
 FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_point_ids) {
   std::ifstream in(file);
   if (!in) throw Error("cannot read " + file.string());
-  std::string line;
-  if (!std::getline(in, line)) throw Error(file.string() + " is empty: a header line is expected");
+  int line = 0;
+  std::vector<std::string> header, fields;
+  if (!ReadCsvRecord(in, file.string(), &line, &header)) throw Error(file.string() + " is empty: a header line is expected");
   std::map<std::string, size_t> column;
-  const std::vector<std::string> header = SplitCsvLine(line);
   for (size_t i = 0; i < header.size(); ++i) column.emplace(header[i], i);
   const auto require = [&](const std::string& name) {
     if (!column.count(name)) throw Error(file.string() + ": no column '" + name + "' in its header (frame, u, v and z are needed)");
@@ -81,10 +72,9 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
   const size_t id_column = has_ids ? column.at("point_id") : 0;
   const size_t needed = std::max({frame_column, u_column, v_column, z_column, id_column}) + 1;
   FrameEstimates estimates;
-  for (int row = 2; std::getline(in, line); ++row) {
-    if (line.empty() || line == "\r") continue;
-    const std::string where = file.string() + ":" + std::to_string(row);
-    const std::vector<std::string> fields = SplitCsvLine(line);
+  while (ReadCsvRecord(in, file.string(), &line, &fields)) {
+    if (fields.size() == 1 && fields[0].empty()) continue;  // a blank line
+    const std::string where = file.string() + ":" + std::to_string(line);
     if (fields.size() < needed) {
       throw Error(where + ": " + std::to_string(fields.size()) + " fields, the header needs " + std::to_string(needed));
     }
@@ -309,8 +299,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << (frame_evaluation.evaluated ? frame_evaluation.scale : 0.0) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
-                << ",0,0,0,0,0,0,0,0,\"" << (!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem)
-                << "\"\n";
+                << ",0,0,0,0,0,0,0,0,"
+                << CsvField(!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem) << '\n';
     // Last used here, so its pairs move into the list kept for the alignments at the end.
     if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }

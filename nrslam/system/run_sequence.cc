@@ -16,6 +16,7 @@
 #include "nrslam/mapping/mapper.h"
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/tracking/tracker.h"
+#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/memory_usage.h"
 #include "nrslam/util/stopwatch.h"
@@ -268,7 +269,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                 << (evaluation.evaluated ? std::to_string(evaluation.flat_rmse_mm) : std::string()) << ','
                 << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
                 << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation << ','
-                << result.ms_joint_solve << ',' << result.ms_linear_solve << ",\"" << result.note << "\"\n";
+                << result.ms_joint_solve << ',' << result.ms_linear_solve << ',' << CsvField(result.note) << '\n';
     if (progress) {
       std::ostringstream line;
       line << "frame " << frame + 1 - first << "/" << summary.frames_total << "  " << ToString(result.state) << "  "
