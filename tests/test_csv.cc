@@ -39,10 +39,11 @@ TEST(Csv, AwkwardFieldsRoundTrip) {
   EXPECT_EQ(lines, 4);  // the record with a line break spans two lines
 }
 
-TEST(Csv, WindowsLineEndsAndEmptyFields) {
+TEST(Csv, WindowsLineEndsByteOrderMarkAndEmptyFields) {
   int lines = 0;
-  const auto records = ReadAll("a,b,c\r\n1,,\r\n\"x\r\ny\",2,3\r\n", &lines);
+  const auto records = ReadAll("\xEF\xBB\xBF" "a,b,c\r\n1,,\r\n\"x\r\ny\",2,3\r\n", &lines);
   ASSERT_EQ(records.size(), 3u);
+  EXPECT_EQ(records[0], (std::vector<std::string>{"a", "b", "c"}));
   EXPECT_EQ(records[1], (std::vector<std::string>{"1", "", ""}));
   EXPECT_EQ(records[2], (std::vector<std::string>{"x\ny", "2", "3"}));
 }

@@ -14,7 +14,8 @@ std::string CsvField(const std::string& text);
 
 // Reads the next record of `in` into `fields`, unquoted. A quoted field may hold commas,
 // quotes and line breaks, so a record can span lines; `*line` counts the lines read so far
-// (for messages), and a '\r' before a line break (a file written on Windows) is dropped.
+// (for messages). A '\r' before a line break (a file written on Windows) and a UTF-8 byte-order
+// mark before the first line (as spreadsheets write) are dropped.
 // Returns false at the end of the stream. Throws Error naming `file` and the line when the
 // stream ends inside a quoted field (a file cut short).
 bool ReadCsvRecord(std::istream& in, const std::string& file, int* line, std::vector<std::string>* fields);
