@@ -310,6 +310,10 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
   EXPECT_NE(error_of("frame,u,v,z\n0,1,2\n").find("3 fields, the header needs 4"), std::string::npos);
   // An estimate a system failed to make (NaN, 0) is no estimate, not a broken file.
   EXPECT_EQ(error_of("frame,u,v,z\n0,10,20,nan\n1,10,20,0\n"), "no error");
+  // Files as other programs write them: spaces after the commas, a spreadsheet's quoted header
+  // and byte-order mark, Windows line ends.
+  EXPECT_EQ(error_of("frame, u, v, z\n0, 10, 20, 30\n"), "no error");
+  EXPECT_EQ(error_of("\xEF\xBB\xBF\"frame\",\"u\",\"v\",\"z\"\r\n0,10,20,30\r\n"), "no error");
   ExternalResult images;
   images.estimates = *base_ / "wrong_size";
   fs::create_directories(images.estimates);

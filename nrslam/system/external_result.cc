@@ -59,6 +59,10 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
   std::vector<std::string> header, fields;
   if (!ReadCsvRecord(in, file.string(), &line, &header)) throw Error(file.string() + " is empty: a header line is expected");
   std::map<std::string, size_t> column;
+  for (std::string& name : header) {  // "frame, u, v, z" (numpy's savetxt with ", ") names frame, u, v and z
+    const size_t first = name.find_first_not_of(' '), last = name.find_last_not_of(' ');
+    name = first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
+  }
   for (size_t i = 0; i < header.size(); ++i) column.emplace(header[i], i);
   const auto require = [&](const std::string& name) {
     if (!column.count(name)) throw Error(file.string() + ": no column '" + name + "' in its header (frame, u, v and z are needed)");
