@@ -1297,6 +1297,48 @@ std::pair<int, std::string> RunCaught(const std::string& command, const std::fil
   return {status, std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>())};
 }
 
+// A baseline that could not serve a check is refused when it is read, saying why; nrslam_eval
+// reads it (and checks where a new one would go) before it runs anything.
+TEST(Baseline, AFileThatCannotServeACheckIsRefusedBeforeAnyRun) {
+  const auto folder = UniqueTempFolder("baseline_refused");
+  std::filesystem::create_directories(folder);
+  const Json good = MakeBaseline({Result("a", 1.0, 60)}, BaselineTolerance{});
+  std::ofstream(folder / "good.json") << good.dump();
+  EXPECT_EQ(ReadBaseline(folder / "good.json"), good);
+  const auto refusal = [&](const std::string& text) {
+    std::ofstream(folder / "bad.json") << text;
+    try {
+      ReadBaseline(folder / "bad.json");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal("{").find("is not valid JSON"), std::string::npos);
+  EXPECT_NE(refusal(R"({"runs": {}})").find("needs \"tolerance\" and \"runs\""), std::string::npos);
+  Json no_rmse = good;
+  no_rmse["runs"]["a"].erase("rmse_mm");
+  EXPECT_NE(refusal(no_rmse.dump()).find("run 'a' needs \"rmse_mm\" and \"frames_tracked\" numbers"),
+            std::string::npos);
+  EXPECT_THROW(ReadBaseline(folder / "missing.json"), Error);
+
+  const std::filesystem::path manifest =
+      WriteFile(folder / "m.json", R"({"sequences": [{"name": "a", "preset": "sim-0"}]})");
+  const std::string eval = kPrograms.eval.string() + " " + manifest.string() + " --out " + (folder / "out").string() +
+                           " --cache " + (folder / "cache").string();
+  const auto [missing, missing_log] = RunCaught(eval + " --check-baseline " + (folder / "missing.json").string(),
+                                                folder / "log.txt");
+  EXPECT_EQ(WEXITSTATUS(missing), 1);
+  EXPECT_NE(missing_log.find("cannot open " + (folder / "missing.json").string()), std::string::npos) << missing_log;
+  const auto [nowhere, nowhere_log] =
+      RunCaught(eval + " --write-baseline " + (folder / "no-such-folder" / "b.json").string(), folder / "log.txt");
+  EXPECT_EQ(WEXITSTATUS(nowhere), 1);
+  EXPECT_NE(nowhere_log.find("--write-baseline: the folder"), std::string::npos) << nowhere_log;
+  EXPECT_FALSE(std::filesystem::exists(folder / "cache"));  // nothing rendered
+  EXPECT_FALSE(std::filesystem::exists(folder / "out"));
+  std::filesystem::remove_all(folder);
+}
+
 // Out-of-range arguments are refused with a message naming them, not replaced by a default or
 // wrapped around: each command exits non-zero, writes nothing, and says what was wrong.
 TEST(Tools, OutOfRangeArgumentsAreRefused) {

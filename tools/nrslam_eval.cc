@@ -65,11 +65,13 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   if (!write_baseline.empty()) {
     nrslam::BaselineTolerance given;
     given.rmse_relative = tolerance;
-    std::ofstream(write_baseline) << nrslam::MakeBaseline(results, given).dump(2) << '\n';
+    std::ofstream file(write_baseline);
+    file << nrslam::MakeBaseline(results, given).dump(2) << '\n';
+    if (!file.flush()) throw nrslam::Error("cannot write the baseline " + write_baseline);
     std::cout << "baseline written: " << write_baseline << '\n';
   }
   if (!check_baseline.empty()) {
-    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, nrslam::ReadJsonFile(check_baseline));
+    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, nrslam::ReadBaseline(check_baseline));
     std::cout << '\n' << check.report;
     if (!check.passed) code = 3;
   }
@@ -199,6 +201,15 @@ int main(int argc, char** argv) {
     std::vector<std::string> resolved;
     if (!config_path.empty()) resolved = nrslam::AssignmentsOverDefaults(nrslam::SystemOptionsFromFile(config_path));
     for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
+    // Before any run: a baseline that cannot be read, or written, would otherwise fail only
+    // after the whole evaluation.
+    if (!check_baseline.empty()) nrslam::ReadBaseline(check_baseline);
+    if (!write_baseline.empty()) {
+      const std::filesystem::path folder = std::filesystem::absolute(write_baseline).parent_path();
+      if (!std::filesystem::is_directory(folder)) {
+        throw nrslam::Error("--write-baseline: the folder " + folder.string() + " does not exist");
+      }
+    }
     if (merge->parsed()) {
       // Runs of the same plan executed elsewhere: gather their run folders under --out.
       const nrslam::Manifest manifest = LoadChosen(merge_manifest, only, seeds);

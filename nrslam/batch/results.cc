@@ -480,18 +480,43 @@ Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance
           {"runs", runs}};
 }
 
-BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline) {
+namespace {
+
+// What a check reads of a baseline, or Error saying what is missing.
+BaselineTolerance ToleranceOf(const Json& baseline) {
   BaselineTolerance tolerance;
-  Json runs;
   try {
     const Json& given = baseline.at("tolerance");
     tolerance.rmse_relative = given.at("rmse_relative");
     tolerance.rmse_absolute_mm = given.at("rmse_absolute_mm");
     tolerance.frames_tracked = given.at("frames_tracked");
-    runs = baseline.at("runs");
+    if (!baseline.at("runs").is_object()) throw Error("baseline: \"runs\" must map run names to their figures");
+    for (const auto& [key, run] : baseline.at("runs").items()) {
+      if (!run.is_object() || !run.value("rmse_mm", Json()).is_number() || !run.value("frames_tracked", Json()).is_number()) {
+        throw Error("baseline: run '" + key + "' needs \"rmse_mm\" and \"frames_tracked\" numbers");
+      }
+    }
   } catch (const Json::exception& e) {
     throw Error(std::string("baseline is malformed (needs \"tolerance\" and \"runs\"): ") + e.what());
   }
+  return tolerance;
+}
+
+}  // namespace
+
+Json ReadBaseline(const std::filesystem::path& file) {
+  const Json baseline = ReadJsonFile(file);
+  try {
+    ToleranceOf(baseline);
+  } catch (const Error& e) {
+    throw Error(file.string() + ": " + e.what());
+  }
+  return baseline;
+}
+
+BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline) {
+  const BaselineTolerance tolerance = ToleranceOf(baseline);
+  const Json& runs = baseline.at("runs");
   std::map<std::string, const RunResult*> by_key;
   for (const RunResult& r : results) by_key[RunKey(r)] = &r;
   std::vector<std::string> baseline_revisions, baseline_codes, run_codes;

@@ -154,7 +154,11 @@ struct BaselineCheck {
   bool passed = true;
   std::string report;  // a table of every baselined run: before, now, verdict
 };
-// Fails on a run that is worse than tolerated, failed, or missing from the results.
+// Fails on a run that is worse than tolerated, failed, or missing from the results. Throws
+// Error when `baseline` lacks what a check needs (a tolerance, and per run its RMSE and frames).
 BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline);
+// A baseline file, read and checked as CheckBaseline needs it: nrslam_eval reads it before any
+// run, so a wrong path or a damaged file fails at once and not after the evaluation.
+Json ReadBaseline(const std::filesystem::path& file);
 
 }  // namespace nrslam
