@@ -11,7 +11,6 @@
 
 #include <atomic>
 #include <csignal>
-#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -29,6 +28,7 @@
 #include "nrslam/util/folder_lock.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace {
@@ -65,9 +65,7 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   if (!write_baseline.empty()) {
     nrslam::BaselineTolerance given;
     given.rmse_relative = tolerance;
-    std::ofstream file(write_baseline);
-    file << nrslam::MakeBaseline(results, given).dump(2) << '\n';
-    if (!file.flush()) throw nrslam::Error("cannot write the baseline " + write_baseline);
+    nrslam::WriteTextFile(write_baseline, nrslam::MakeBaseline(results, given).dump(2) + '\n');
     std::cout << "baseline written: " << write_baseline << '\n';
   }
   if (!check_baseline.empty()) {
@@ -233,8 +231,9 @@ int main(int argc, char** argv) {
     }
     std::filesystem::create_directories(out);
     if (!emit_jobs.empty()) {
-      std::ofstream file(emit_jobs);
-      for (const nrslam::RunJob& run : plan.runs) file << nrslam::RunShellLine(plan, run, programs) << '\n';
+      std::string jobs_text;
+      for (const nrslam::RunJob& run : plan.runs) jobs_text += nrslam::RunShellLine(plan, run, programs) + '\n';
+      nrslam::WriteTextFile(emit_jobs, jobs_text);
       // merge must plan the same runs, so it is given every option that shapes the plan, quoted
       // as the shell needs (a wildcard of --only, a value with spaces).
       std::vector<std::string> merge_command = {"nrslam_eval", "merge", manifest_path, "--out", out};

@@ -18,6 +18,7 @@
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -59,7 +60,7 @@ std::vector<std::string> SplitList(const std::string& text) {
 
 void WriteFailure(const RunJob& run, const std::string& stage, const std::string& message) {
   std::filesystem::create_directories(run.run_folder);
-  std::ofstream(run.run_folder / "failure.json") << Json{{"stage", stage}, {"error", message}}.dump(2) << '\n';
+  WriteTextFile(run.run_folder / "failure.json", Json{{"stage", stage}, {"error", message}}.dump(2) + '\n');
 }
 
 // The last non-empty line of a log, where the programs put their error message.

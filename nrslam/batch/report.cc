@@ -3,7 +3,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -17,6 +16,7 @@
 #include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -327,7 +327,7 @@ void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidC
           "+' plots='+document.querySelectorAll('svg.plot').length"
           "+' series='+document.querySelectorAll('svg.plot polyline.series').length;});</script>\n";
   html << "</body></html>\n";
-  std::ofstream(folder / "index.html") << html.str();
+  WriteTextFile(folder / "index.html", html.str());
 }
 
 }  // namespace nrslam

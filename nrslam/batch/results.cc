@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -13,6 +12,7 @@
 #include "nrslam/util/csv.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -323,8 +323,8 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
 
 void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
   std::filesystem::create_directories(folder);
-  std::ofstream(folder / "results.json") << ToJson(results).dump(2) << '\n';
-  std::ofstream csv(folder / "results.csv");
+  WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
+  std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,frames_groundtruth_unreadable,rmse_mm,rmse_median_mm,"
          "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,"
          "birth_log_error_mean,birth_log_error_median,revision,code,error\n";
@@ -336,6 +336,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
         << ',' << RecordedField(r.birth_log_error_median) << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
+  WriteTextFile(folder / "results.csv", csv.str());
 }
 
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder) {

@@ -2,11 +2,12 @@
 
 #include <cmath>
 #include <exception>
-#include <fstream>
+#include <sstream>
 
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -144,7 +145,7 @@ void PrintRigidComparison(const std::vector<RigidComparison>& comparisons, std::
 }
 
 void WriteRigidComparison(const std::vector<RigidComparison>& comparisons, const std::filesystem::path& file) {
-  std::ofstream csv(file);
+  std::ostringstream csv;
   csv << "deformable_run,rigid_run,deformable_rmse_mm,rigid_rmse_mm,deformable_frames_tracked,rigid_frames_tracked,"
          "frames_total,common_frames,deformable_common_rmse_mm,rigid_common_rmse_mm,same_points_frames,"
          "same_points_per_frame,deformable_same_points_rmse_mm,rigid_same_points_rmse_mm\n";
@@ -163,6 +164,7 @@ void WriteRigidComparison(const std::vector<RigidComparison>& comparisons, const
     }
     csv << '\n';
   }
+  WriteTextFile(file, csv.str());
 }
 
 }  // namespace nrslam

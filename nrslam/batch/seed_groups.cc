@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/median.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -146,7 +147,7 @@ void PrintSeedGroups(const std::vector<SeedGroup>& groups, std::ostream& out) {
 }
 
 void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem::path& file) {
-  std::ofstream csv(file);
+  std::ostringstream csv;
   csv << "preset,seeds,sequences,runs,scored,to_end,mean_rmse_mm,sd_rmse_mm,median_rmse_mm,min_rmse_mm,max_rmse_mm,"
          "mean_map_scale_mm,mean_ate_mm\n";
   for (const SeedGroup& group : groups) {
@@ -163,6 +164,7 @@ void WriteSeedGroups(const std::vector<SeedGroup>& groups, const std::filesystem
     }
     csv << '\n';
   }
+  WriteTextFile(file, csv.str());
 }
 
 }  // namespace nrslam

@@ -1,0 +1,28 @@
+#include "nrslam/util/text_file.h"
+
+#include <unistd.h>
+
+#include <fstream>
+#include <system_error>
+
+#include "nrslam/util/error.h"
+
+namespace nrslam {
+
+void WriteTextFile(const std::filesystem::path& path, const std::string& text) {
+  // A name of this process's own: no other writer's temporary file is taken for this one.
+  std::filesystem::path partial = path;
+  partial += ".partial-" + std::to_string(getpid());
+  std::ofstream file(partial, std::ios::binary);
+  file << text;
+  file.close();  // a full disk may show only when the last buffer is written
+  std::error_code error;
+  if (!file.fail()) std::filesystem::rename(partial, path, error);
+  if (file.fail() || error) {
+    std::error_code ignored;
+    std::filesystem::remove(partial, ignored);
+    throw Error("cannot write " + path.string() + (error ? ": " + error.message() : ""));
+  }
+}
+
+}  // namespace nrslam

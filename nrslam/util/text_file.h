@@ -1,0 +1,15 @@
+// util: writing a whole text file (a results table, a report, a baseline) so that a reader never
+// finds half of one: a full disk or a missing folder is an error, not a silently short file.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace nrslam {
+
+// Writes `text` as the whole content of `path`, whole or not at all: into a temporary file
+// beside it, renamed over `path` once written (an interrupted write leaves the old file).
+// Throws Error naming the file when it cannot be written.
+void WriteTextFile(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace nrslam

@@ -1,0 +1,46 @@
+// A whole text file is written whole or not at all, and a file that cannot be written is an
+// error rather than a silently missing or short one.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
+#include "temp_folder.h"
+
+namespace nrslam {
+namespace {
+
+std::string Contents(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+TEST(TextFile, ReplacesTheWholeFileAndLeavesNothingElse) {
+  const auto folder = UniqueTempFolder("text_file");
+  std::filesystem::create_directories(folder);
+  WriteTextFile(folder / "results.csv", "a,b\n1,2\n3,4\n");
+  WriteTextFile(folder / "results.csv", "a,b\n5,6\n");
+  EXPECT_EQ(Contents(folder / "results.csv"), "a,b\n5,6\n");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder), {}), 1);  // no temporary left
+  std::filesystem::remove_all(folder);
+}
+
+TEST(TextFile, AFileThatCannotBeWrittenIsAnError) {
+  const auto folder = UniqueTempFolder("text_file_missing");
+  std::filesystem::remove_all(folder);
+  try {
+    WriteTextFile(folder / "results.json", "{}\n");
+    ADD_FAILURE() << "wrote into a folder that does not exist";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot write " + (folder / "results.json").string()), std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace nrslam
