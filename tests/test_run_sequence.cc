@@ -5,6 +5,7 @@
 #include <omp.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -1062,6 +1063,31 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   const std::vector<std::string> late_metrics = FileLines(folder / "late_run" / "metrics.csv");
   ASSERT_EQ(late_metrics.size(), 11u);
   EXPECT_NE(late_metrics[1].find("000000.png"), std::string::npos) << late_metrics[1];
+  fs::remove_all(folder);
+}
+
+// A disk that fills during a run ends it with an error that says so, within a few frames, and
+// leaves no summary.json: a run folder without one is not a finished run (nrslam_eval runs it
+// again) rather than a finished run with short files. Needs a small filesystem of its own,
+// which root can mount.
+TEST(RunSequenceErrors, AFullDiskEndsTheRunWithAnErrorAndNoSummary) {
+  const fs::path folder = UniqueTempFolder("nrslam_full_disk");
+  fs::remove_all(folder);
+  fs::create_directories(folder / "small");
+  if (geteuid() != 0 || std::system(("mount -t tmpfs -o size=96k tmpfs " + (folder / "small").string() +
+                                     " > /dev/null 2>&1").c_str()) != 0) {
+    fs::remove_all(folder);
+    GTEST_SKIP() << "cannot mount a small filesystem here";
+  }
+  SimulateSmall("sim-0", 30, 160, 120, folder / "sequence");
+  try {
+    RunSequence(folder / "sequence", TrackingExperiment(), folder / "small" / "run");
+    ADD_FAILURE() << "the run ended as if its files were whole";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("(is the disk full?)"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(folder / "small" / "run" / "summary.json"));
+  EXPECT_EQ(std::system(("umount " + (folder / "small").string()).c_str()), 0);
   fs::remove_all(folder);
 }
 

@@ -2,11 +2,10 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include <fstream>
-
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -40,9 +39,7 @@ SequenceWriter::SequenceWriter(const fs::path& folder, const SequenceInfo& info,
   if (with_depth) fs::create_directories(folder / "depth", error);
   if (info.stereo) fs::create_directories(folder / "right", error);
   if (error) throw Error("cannot create " + folder.string() + ": " + error.message());
-  std::ofstream file(folder / "sequence.json");
-  if (!file) throw Error("cannot write " + (folder / "sequence.json").string());
-  file << nlohmann::json(info_).dump(2) << '\n';
+  WriteTextFile(folder / "sequence.json", nlohmann::json(info_).dump(2) + '\n');
 }
 
 void SequenceWriter::WritePng(const fs::path& path, const cv::Mat& image) const {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 
@@ -19,6 +20,7 @@ void WriteTum(const std::filesystem::path& path, const std::vector<StampedPose>&
     file << pose.timestamp << ' ' << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y()
          << ' ' << q.z() << ' ' << q.w() << '\n';
   }
+  CloseWritten(file, path);
 }
 
 std::vector<StampedPose> ReadTum(const std::filesystem::path& path) {

@@ -19,6 +19,7 @@
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -310,6 +311,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   }
   AggregateInto(&summary, evaluations, aligned, evaluation);
   summary.births = births.Summarise();
+  CloseWritten(points_csv, out / "points.csv");
+  CloseWritten(metrics_csv, out / "metrics.csv");
   WriteTum(out / "trajectory.tum", trajectory);
   WriteSummaryJson(out / "summary.json", summary, {{"init", "external"}, {"mapping", nullptr}, {"mode", "external"}});
   return summary;

@@ -8,6 +8,7 @@
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 
@@ -99,8 +100,7 @@ RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::fil
                            {"nrslam_code", CodeFingerprint()},
                            {"sequence", std::filesystem::absolute(sequence).string()}};
     written.update(config);
-    std::ofstream file = OpenForWriting(out / "config.json");
-    file << written.dump(2) << '\n';
+    WriteTextFile(out / "config.json", written.dump(2) + '\n');
   }
   RunFolderStreams streams{OpenForWriting(out / "points.csv"), OpenForWriting(out / "metrics.csv")};
   streams.points << kPointsCsvHeader << '\n';
@@ -165,8 +165,8 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
   json["status"] = summary.Status();
   json["stop_frame"] = summary.stop_frame >= 0 ? nlohmann::json(summary.stop_frame) : nlohmann::json();
   json["stop_reason"] = summary.stop_frame >= 0 ? nlohmann::json(summary.stop_reason) : nlohmann::json();
-  std::ofstream file = OpenForWriting(path);
-  file << json.dump(2) << '\n';
+  // Whole or not at all: a folder with summary.json holds a finished run (nrslam_eval reuses it).
+  WriteTextFile(path, json.dump(2) + '\n');
 }
 
 }  // namespace nrslam

@@ -20,6 +20,7 @@
 #include "nrslam/util/error.h"
 #include "nrslam/util/memory_usage.h"
 #include "nrslam/util/stopwatch.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -46,6 +47,7 @@ void WritePly(const fs::path& path, const Map& map) {
     file << point.position.x() << ' ' << point.position.y() << ' ' << point.position.z() << ' '
          << int(point.colour[2]) << ' ' << int(point.colour[1]) << ' ' << int(point.colour[0]) << '\n';
   }
+  CloseWritten(file, path);
 }
 
 struct FrameImages {
@@ -270,6 +272,10 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                 << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
                 << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation << ','
                 << result.ms_joint_solve << ',' << result.ms_linear_solve << ',' << CsvField(result.note) << '\n';
+    // A full disk shows here within a few frames, not after the whole run.
+    if (points_csv.fail() || metrics_csv.fail()) {
+      throw Error("cannot write the run's files in " + out.string() + " (is the disk full?)");
+    }
     if (progress) {
       std::ostringstream line;
       line << "frame " << frame + 1 - first << "/" << summary.frames_total << "  " << ToString(result.state) << "  "
@@ -295,6 +301,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   AggregateInto(&summary, evaluations, aligned_maps, options.evaluation);
   summary.births = births.Summarise();
 
+  CloseWritten(points_csv, out / "points.csv");
+  CloseWritten(metrics_csv, out / "metrics.csv");
+  CloseWritten(log, out / "run.log");
   WriteTum(out / "trajectory.tum", trajectory);
   WritePly(out / "map.ply", tracker.map());
   WriteSummaryJson(out / "summary.json", summary,

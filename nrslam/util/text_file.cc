@@ -25,4 +25,9 @@ void WriteTextFile(const std::filesystem::path& path, const std::string& text) {
   }
 }
 
+void CloseWritten(std::ofstream& file, const std::filesystem::path& path) {
+  file.close();
+  if (file.fail()) throw Error("cannot write " + path.string() + " (is the disk full?)");
+}
+
 }  // namespace nrslam

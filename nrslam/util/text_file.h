@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace nrslam {
@@ -11,5 +12,9 @@ namespace nrslam {
 // beside it, renamed over `path` once written (an interrupted write leaves the old file).
 // Throws Error naming the file when it cannot be written.
 void WriteTextFile(const std::filesystem::path& path, const std::string& text);
+
+// Closes `file`, written piece by piece to `path` (a run's points.csv as its frames come);
+// throws Error naming `path` when any of it could not be written.
+void CloseWritten(std::ofstream& file, const std::filesystem::path& path);
 
 }  // namespace nrslam
