@@ -15,6 +15,7 @@
 #include "nrslam/eval/error_view.h"
 #include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
+#include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
@@ -150,7 +151,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
         }
         const std::string name = Slug(result) + "_depth_error_" + std::to_string(frame) + ".png";
         const ErrorView view = DrawErrorView(sequence.ReadRgb(frame), depth_mm, points[frame], evaluation, view_options);
-        cv::imwrite((folder / name).string(), view.image);
+        if (!cv::imwrite((folder / name).string(), view.image)) throw Error("cannot write " + (folder / name).string());
         html << "<figure><img src=\"" << EscapeXml(name) << "\" width=\"640\"><figcaption>frame " << frame;
         if (view.evaluation.evaluated) {
           html << ", RMSE " << FormatFixed(view.evaluation.rmse_mm, 2) << " mm, full colour at ±"
