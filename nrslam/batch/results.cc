@@ -280,7 +280,8 @@ Json ToJson(const std::vector<RunResult>& results) {
     rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated},
-                    {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable}, {"rmse_mm", r.rmse_mm}, {"rmse_median_mm", r.rmse_median_mm},
+                    {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable}, {"rmse_mm", r.rmse_mm},
+                    {"rmse_median_mm", r.rmse_median_mm},
                     {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
                     {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
                     {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
@@ -325,12 +326,14 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::filesystem::create_directories(folder);
   WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
   std::ostringstream csv;
-  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,frames_groundtruth_unreadable,rmse_mm,rmse_median_mm,"
-         "rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,"
-         "birth_log_error_mean,birth_log_error_median,revision,code,error\n";
+  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
+         "frames_groundtruth_unreadable,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,"
+         "ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,"
+         "error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
-        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ',' << r.frames_groundtruth_unreadable << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
+        << r.frames_groundtruth_unreadable << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
@@ -493,7 +496,8 @@ BaselineTolerance ToleranceOf(const Json& baseline) {
     tolerance.frames_tracked = given.at("frames_tracked");
     if (!baseline.at("runs").is_object()) throw Error("baseline: \"runs\" must map run names to their figures");
     for (const auto& [key, run] : baseline.at("runs").items()) {
-      if (!run.is_object() || !run.value("rmse_mm", Json()).is_number() || !run.value("frames_tracked", Json()).is_number()) {
+      if (!run.is_object() || !run.value("rmse_mm", Json()).is_number() ||
+          !run.value("frames_tracked", Json()).is_number()) {
         throw Error("baseline: run '" + key + "' needs \"rmse_mm\" and \"frames_tracked\" numbers");
       }
     }

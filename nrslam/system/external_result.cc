@@ -58,9 +58,12 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
   if (!in) throw Error("cannot read " + file.string());
   int line = 0;
   std::vector<std::string> header, fields;
-  if (!ReadCsvRecord(in, file.string(), &line, &header)) throw Error(file.string() + " is empty: a header line is expected");
+  if (!ReadCsvRecord(in, file.string(), &line, &header)) {
+    throw Error(file.string() + " is empty: a header line is expected");
+  }
   std::map<std::string, size_t> column;
-  for (std::string& name : header) {  // "frame, u, v, z" (numpy's savetxt with ", ") names frame, u, v and z
+  // "frame, u, v, z" (numpy's savetxt with ", ") names frame, u, v and z.
+  for (std::string& name : header) {
     const size_t first = name.find_first_not_of(' '), last = name.find_last_not_of(' ');
     name = first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
   }

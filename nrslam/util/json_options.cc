@@ -118,8 +118,10 @@ Json ParseLike(const Json& existing, const std::string& text, const std::string&
   }
   std::ostringstream message;
   message << "option " << path << ": cannot use '" << text << "' (expected "
-          << (existing.is_number_float() ? "a finite number" : existing.is_number_integer() ? "a whole number" : existing.type_name()) << ", like "
-          << existing.dump() << ")";
+          << (existing.is_number_float()     ? "a finite number"
+              : existing.is_number_integer() ? "a whole number"
+                                             : existing.type_name())
+          << ", like " << existing.dump() << ")";
   throw Error(message.str());
 }
 
