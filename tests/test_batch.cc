@@ -531,17 +531,21 @@ TEST(Results, WhereAndWhyARunStoppedIsShownAndKept) {
   EXPECT_TRUE(ToJson({fine})["results"][0]["stop_reason"].is_null());
 }
 
-TEST(Results, FramesLeftUnscoredByUnreadableGroundTruthAreShownAndKept) {
+TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesAreShownAndKept) {
   RunResult damaged = Result("sim-2", 0.5, 60);
   damaged.frames_evaluated = 58;
+  damaged.frames_unreadable = 1;
   damaged.frames_groundtruth_unreadable = 2;
   const RunResult fine = Result("sim-0", 0.1, 60);
   std::stringstream table;
   PrintResults({damaged, fine}, table);
-  EXPECT_NE(table.str().find("sim-2: ground-truth depth unreadable on 2 tracked frames, not scored"), std::string::npos)
+  EXPECT_NE(table.str().find("sim-2: 1 frame unreadable (lost); ground-truth depth unreadable on 2 tracked frames "
+                             "(not scored); metrics.csv names the files"),
+            std::string::npos)
       << table.str();
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
   const std::vector<RunResult> read = ResultsFromJson(ToJson({damaged, fine}));
+  EXPECT_EQ(read[0].frames_unreadable, 1);
   EXPECT_EQ(read[0].frames_groundtruth_unreadable, 2);
   EXPECT_EQ(read[1].frames_groundtruth_unreadable, 0);
 }

@@ -993,6 +993,9 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   const RunSummary summary = RunSequence(folder, options, folder / "run");
   EXPECT_EQ(summary.frames_tracked, 9);
   EXPECT_EQ(summary.frames_lost, 1);
+  EXPECT_EQ(summary.frames_unreadable, 1);
+  EXPECT_NE(DescribeSummary(summary).find("1 frame unreadable (lost); metrics.csv names the files"), std::string::npos)
+      << DescribeSummary(summary);
   std::ifstream metrics(folder / "run" / "metrics.csv");
   std::vector<std::string> rows;
   for (std::string line; std::getline(metrics, line);) rows.push_back(line);
@@ -1043,8 +1046,10 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   EXPECT_NE(metrics[7].find("not scored: cannot decode"), std::string::npos) << metrics[7];
   EXPECT_NE(metrics[7].find("000006.png"), std::string::npos) << metrics[7];
   EXPECT_EQ(ReadJsonFile(folder / "damaged_run" / "summary.json").at("frames_groundtruth_unreadable"), 1);
-  EXPECT_NE(DescribeSummary(damaged).find("ground-truth depth unreadable on 1 tracked frame"), std::string::npos)
+  EXPECT_NE(DescribeSummary(damaged).find("ground-truth depth unreadable on 1 tracked frame (not scored)"),
+            std::string::npos)
       << DescribeSummary(damaged);
+  EXPECT_EQ(damaged.frames_unreadable, 0);
 
   ExternalResult external;
   external.estimates = folder / "whole_run" / "points.csv";
@@ -1060,6 +1065,7 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   const RunSummary late = RunSequence(folder / "damaged", TrackingExperiment(), folder / "late_run");
   EXPECT_EQ(late.init_frame, 1);
   EXPECT_EQ(late.frames_tracked, 9);
+  EXPECT_EQ(late.frames_unreadable, 1);  // where the map starts, depth is input
   const std::vector<std::string> late_metrics = FileLines(folder / "late_run" / "metrics.csv");
   ASSERT_EQ(late_metrics.size(), 11u);
   EXPECT_NE(late_metrics[1].find("000000.png"), std::string::npos) << late_metrics[1];

@@ -18,9 +18,18 @@ std::string DescribeStop(int init_frame, int stop_frame, const std::string& reas
   return "lost from frame " + std::to_string(stop_frame) + ": " + reason;
 }
 
-std::string UnreadableGroundTruthText(int frames) {
-  return "ground-truth depth unreadable on " + std::to_string(frames) + " tracked frame" + (frames == 1 ? "" : "s") +
-         ", not scored; metrics.csv names the files";
+std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_unreadable) {
+  const auto plural = [](int count) { return count == 1 ? "" : "s"; };
+  std::string text;
+  if (frames_unreadable > 0) {
+    text = std::to_string(frames_unreadable) + " frame" + plural(frames_unreadable) + " unreadable (lost)";
+  }
+  if (frames_groundtruth_unreadable > 0) {
+    text += (text.empty() ? "" : "; ") + std::string("ground-truth depth unreadable on ") +
+            std::to_string(frames_groundtruth_unreadable) + " tracked frame" + plural(frames_groundtruth_unreadable) +
+            " (not scored)";
+  }
+  return text.empty() ? text : text + "; metrics.csv names the files";
 }
 
 std::string RunSummary::Status() const {
@@ -62,9 +71,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
-  if (summary.frames_groundtruth_unreadable > 0) {
-    text << '\n' << UnreadableGroundTruthText(summary.frames_groundtruth_unreadable);
-  }
+  const std::string unreadable = UnreadableInputText(summary.frames_unreadable, summary.frames_groundtruth_unreadable);
+  if (!unreadable.empty()) text << '\n' << unreadable;
   return text.str();
 }
 
@@ -142,6 +150,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_total", summary.frames_total},
                       {"frames_lost", summary.frames_lost},
                       {"frames_evaluated", summary.frames_evaluated},
+                      {"frames_unreadable", summary.frames_unreadable},
                       {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},

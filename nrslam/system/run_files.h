@@ -34,8 +34,9 @@ struct RunSummary {
   int frames_lost = 0;
   int init_frame = -1;
   int frames_evaluated = 0;
-  // Tracked frames left unscored because their ground-truth depth file could not be read.
-  int frames_groundtruth_unreadable = 0;
+  // Frames lost because their colour image or mask could not be read (the run goes on), and
+  // tracked frames left unscored because their ground-truth depth file could not be read.
+  int frames_unreadable = 0, frames_groundtruth_unreadable = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)
   // The process's peak resident memory when the run ended (MB; util/memory_usage.h): the run's
   // own under nrslam_run and nrslam_eval, which give each sequence its own process. 0: not measured.
@@ -62,8 +63,9 @@ struct RunSummary {
 // outlier rejection" or "never initialised: …"; "" when `reason` is empty (it ends tracking).
 std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason);
 
-// "ground-truth depth unreadable on 2 tracked frames, not scored; metrics.csv names the files".
-std::string UnreadableGroundTruthText(int frames);
+// What damaged input cost a run, e.g. "1 frame unreadable (lost); ground-truth depth unreadable
+// on 2 tracked frames (not scored); metrics.csv names the files"; "" when nothing.
+std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_unreadable);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked

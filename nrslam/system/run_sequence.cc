@@ -216,6 +216,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     } catch (const Error& e) {
       result.state = TrackingState::kLost;  // an unreadable frame: recorded, and the run goes on
       result.note = e.what();
+      ++summary.frames_unreadable;
       log << "frame " << frame << ": " << e.what() << '\n';
     }
 
