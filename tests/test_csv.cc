@@ -32,11 +32,11 @@ TEST(Csv, AwkwardFieldsRoundTrip) {
   EXPECT_EQ(CsvField("plain"), "plain");  // quoted only when needed
   EXPECT_EQ(CsvField("say \"hi\""), "\"say \"\"hi\"\"\"");
   int lines = 0;
-  const auto records = ReadAll("h\n" + line + "\nlast\n", &lines);
+  const auto records = ReadAll("h\n" + line + "\n\nlast\n", &lines);
   ASSERT_EQ(records.size(), 3u);
   EXPECT_EQ(records[1], fields);
-  EXPECT_EQ(records[2], std::vector<std::string>{"last"});
-  EXPECT_EQ(lines, 4);  // the record with a line break spans two lines
+  EXPECT_EQ(records[2], std::vector<std::string>{"last"});  // the blank line passed over
+  EXPECT_EQ(lines, 5);  // the record with a line break spans two lines
 }
 
 TEST(Csv, WindowsLineEndsByteOrderMarkAndEmptyFields) {

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <csignal>
 #include <iostream>
+#include <optional>
 #include <thread>
 
 #include "nrslam/batch/evaluation_plan.h"
@@ -42,8 +43,9 @@ nrslam::Programs SiblingPrograms() {
 }
 
 // Exit codes: 0 all well, 1 bad usage or input, 2 some run failed, 3 baseline check failed.
-int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out, const std::string& check_baseline,
-           const std::string& write_baseline, double tolerance) {
+// `baseline`: the --check-baseline file as read before the runs.
+int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
+           const std::optional<nrslam::Json>& baseline, const std::string& write_baseline, double tolerance) {
   const std::vector<nrslam::RunResult> results = nrslam::CollectResults(plan);
   const std::vector<nrslam::RigidComparison> comparisons = nrslam::CompareWithRigid(plan, results);
   nrslam::WriteResults(results, out);
@@ -68,8 +70,8 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
     nrslam::WriteTextFile(write_baseline, nrslam::MakeBaseline(results, given).dump(2) + '\n');
     std::cout << "baseline written: " << write_baseline << '\n';
   }
-  if (!check_baseline.empty()) {
-    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, nrslam::ReadBaseline(check_baseline));
+  if (baseline) {
+    const nrslam::BaselineCheck check = nrslam::CheckBaseline(results, *baseline);
     std::cout << '\n' << check.report;
     if (!check.passed) code = 3;
   }
@@ -201,7 +203,8 @@ int main(int argc, char** argv) {
     for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
     // Before any run: a baseline that cannot be read, or written, would otherwise fail only
     // after the whole evaluation.
-    if (!check_baseline.empty()) nrslam::ReadBaseline(check_baseline);
+    std::optional<nrslam::Json> baseline;
+    if (!check_baseline.empty()) baseline = nrslam::ReadBaseline(check_baseline);
     if (!write_baseline.empty()) {
       const std::filesystem::path folder = std::filesystem::absolute(write_baseline).parent_path();
       if (!std::filesystem::is_directory(folder)) {
@@ -220,7 +223,7 @@ int main(int argc, char** argv) {
           if (std::filesystem::exists(candidate / "summary.json")) run.run_folder = candidate;
         }
       }
-      return Finish(plan, out, check_baseline, write_baseline, tolerance);
+      return Finish(plan, out, baseline, write_baseline, tolerance);
     }
     if (manifest_path.empty()) throw nrslam::Error("a manifest is required (see data_manifests/)");
     const nrslam::Manifest manifest = LoadChosen(manifest_path, only, seeds);
@@ -268,7 +271,7 @@ int main(int argc, char** argv) {
       std::cerr << "nrslam_eval: interrupted; the runs that finished are kept, and the same command resumes\n";
       return 130;
     }
-    return Finish(plan, out, check_baseline, write_baseline, tolerance);
+    return Finish(plan, out, baseline, write_baseline, tolerance);
   } catch (const std::exception& e) {
     std::cerr << "nrslam_eval: " << e.what() << '\n';
     return 1;

@@ -19,7 +19,6 @@ std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::p
   int line = 0;
   if (!ReadCsvRecord(stream, file.string(), &line, &header)) return rows;
   while (ReadCsvRecord(stream, file.string(), &line, &fields)) {
-    if (fields.size() == 1 && fields[0].empty()) continue;  // a blank line
     // Every row of a file nrslam wrote has the header's fields: fewer or more is damage.
     if (fields.size() != header.size()) {
       throw Error(file.string() + ":" + std::to_string(line) + ": " + std::to_string(fields.size()) +

@@ -81,7 +81,6 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
   const size_t needed = std::max({frame_column, u_column, v_column, z_column, id_column}) + 1;
   FrameEstimates estimates;
   while (ReadCsvRecord(in, file.string(), &line, &fields)) {
-    if (fields.size() == 1 && fields[0].empty()) continue;  // a blank line
     const std::string where = file.string() + ":" + std::to_string(line);
     if (fields.size() < needed) {
       throw Error(where + ": " + std::to_string(fields.size()) + " fields, the header needs " + std::to_string(needed));

@@ -26,10 +26,12 @@ bool ReadLine(std::istream& in, std::string* text, int* line) {
 bool ReadCsvRecord(std::istream& in, const std::string& file, int* line, std::vector<std::string>* fields) {
   fields->clear();
   std::string text;
-  if (!ReadLine(in, &text, line)) return false;
+  do {
+    if (!ReadLine(in, &text, line)) return false;
+    // The byte-order mark some programs (spreadsheets, Python's utf-8-sig) put before the header.
+    if (*line == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
+  } while (text.empty());
   const int first_line = *line;
-  // The byte-order mark some programs (spreadsheets, Python's utf-8-sig) put before the header.
-  if (first_line == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
   std::string field;
   bool quoted = false;
   size_t i = 0;

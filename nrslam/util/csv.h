@@ -12,8 +12,8 @@ namespace nrslam {
 // `text` as one CSV field: quoted only when it needs to be.
 std::string CsvField(const std::string& text);
 
-// Reads the next record of `in` into `fields`, unquoted. A quoted field may hold commas,
-// quotes and line breaks, so a record can span lines; `*line` counts the lines read so far
+// Reads the next record of `in` into `fields`, unquoted, passing over blank lines. A quoted
+// field may hold commas, quotes and line breaks, so a record can span lines; `*line` counts the lines read so far
 // (for messages). A '\r' before a line break (a file written on Windows) and a UTF-8 byte-order
 // mark before the first line (as spreadsheets write) are dropped.
 // Returns false at the end of the stream. Throws Error naming `file` and the line when the
