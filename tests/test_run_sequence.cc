@@ -980,6 +980,13 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
 
 // Frames are read ahead of the tracker and depth maps written behind it (run_sequence.cc): a
 // frame that cannot be read must still be the one recorded as failed, and the run go on.
+std::vector<std::string> FileLines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
 TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   const fs::path folder = UniqueTempFolder("nrslam_corrupt_frame");
   fs::remove_all(folder);
@@ -996,9 +1003,7 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   EXPECT_EQ(summary.frames_unreadable, 1);
   EXPECT_NE(DescribeSummary(summary).find("1 frame unreadable (lost); metrics.csv names the files"), std::string::npos)
       << DescribeSummary(summary);
-  std::ifstream metrics(folder / "run" / "metrics.csv");
-  std::vector<std::string> rows;
-  for (std::string line; std::getline(metrics, line);) rows.push_back(line);
+  const std::vector<std::string> rows = FileLines(folder / "run" / "metrics.csv");
   ASSERT_EQ(rows.size(), 11u);
   for (int frame = 0; frame < 10; ++frame) {
     const std::string& row = rows[static_cast<size_t>(frame) + 1];
@@ -1010,13 +1015,6 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   EXPECT_EQ(summary.stop_frame, -1);
   EXPECT_TRUE(ReadJsonFile(folder / "run" / "summary.json").at("stop_reason").is_null());
   fs::remove_all(folder);
-}
-
-std::vector<std::string> FileLines(const fs::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
 }
 
 // A damaged ground-truth depth map costs its frame the score and nothing else: the frame is

@@ -206,28 +206,35 @@ int main(int argc, char** argv) {
       return 0;
     }
     int skipped = 0;  // frames whose colour image could not be read
-    if (fs::path(out).extension() == ".avi") {
+    const bool to_video = fs::path(out).extension() == ".avi";
+    if (to_video) {
       // Motion JPEG: OpenCV writes it without any external codec.
       // A skipped frame is a black one, so the video keeps the sequence's timing; those before
       // the first drawn frame wait for its size.
       cv::VideoWriter video;
-      cv::Size size;
-      int black_frames = 0;
+      cv::Mat black;  // the size of the drawn frames, once the first is drawn
+      int waiting = 0;
       for (int index = 0; index < preview.frame_count(); ++index) {
         const std::optional<cv::Mat> image = DrawOrSkip(preview, index);
-        skipped += !image;
-        if (!image) ++black_frames;
-        if (image && !video.isOpened()) {
-          size = image->size();
-          if (!video.open(out, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), preview.fps(), size)) {
+        if (!image) {
+          ++skipped;
+          if (black.empty()) {
+            ++waiting;
+          } else {
+            video.write(black);
+          }
+          continue;
+        }
+        if (black.empty()) {
+          if (!video.open(out, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), preview.fps(), image->size())) {
             throw nrslam::Error("cannot write the video " + out);
           }
+          black = cv::Mat::zeros(image->size(), CV_8UC3);
+          for (; waiting > 0; --waiting) video.write(black);
         }
-        if (!video.isOpened()) continue;
-        for (; black_frames > 0; --black_frames) video.write(cv::Mat(size, CV_8UC3, cv::Scalar::all(0)));
-        if (image) video.write(*image);
+        video.write(*image);
       }
-      if (!video.isOpened()) throw nrslam::Error("no frame of the sequence could be drawn");
+      if (black.empty()) throw nrslam::Error("no frame of the sequence could be drawn");
     } else {
       fs::create_directories(out);
       for (int index = 0; index < preview.frame_count(); ++index) {
@@ -238,9 +245,8 @@ int main(int argc, char** argv) {
         if (image) WritePng(fs::path(out) / name, *image);
       }
     }
-    const bool video = fs::path(out).extension() == ".avi";
-    std::cout << "wrote " << preview.frame_count() - (video ? 0 : skipped) << " frames to " << out;
-    if (skipped > 0) std::cout << " (" << skipped << " unreadable: " << (video ? "black" : "left out") << ")";
+    std::cout << "wrote " << preview.frame_count() - (to_video ? 0 : skipped) << " frames to " << out;
+    if (skipped > 0) std::cout << " (" << skipped << " unreadable: " << (to_video ? "black" : "left out") << ")";
     std::cout << '\n';
   } catch (const std::exception& e) {
     std::cerr << "nrslam_preview: " << e.what() << '\n';

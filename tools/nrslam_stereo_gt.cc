@@ -48,16 +48,18 @@ int main(int argc, char** argv) {
     std::vector<int> unreadable;  // frames whose pair could not be read: no depth (0) there
     const cv::Mat no_depth = cv::Mat::zeros(info.camera.height(), info.camera.width(), CV_32F);
     for (int i = 0; i < sequence.frame_count(); ++i) {
-      cv::Mat depth_mm;
+      // Only reading is forgiven: an error of the matching itself still ends the tool.
+      cv::Mat left, right;
       try {
-        depth_mm = nrslam::StereoDepthMm(sequence.ReadRgb(i), sequence.ReadRight(i), info.camera.fx(),
-                                         info.stereo->baseline_mm, options);
+        left = sequence.ReadRgb(i);
+        right = sequence.ReadRight(i);
       } catch (const nrslam::Error& e) {
         std::cerr << "nrslam_stereo_gt: frame " << i << ": " << e.what() << "; written without depth\n";
         unreadable.push_back(i);
-        depth_mm = no_depth;
       }
-      staged.WriteDepthMm(i, depth_mm);
+      staged.WriteDepthMm(i, left.empty() || right.empty()
+                                 ? no_depth
+                                 : nrslam::StereoDepthMm(left, right, info.camera.fx(), info.stereo->baseline_mm, options));
       if (!quiet) {
         progress.Update("depth " + std::to_string(i + 1) + "/" + std::to_string(sequence.frame_count()),
                         i + 1 == sequence.frame_count());
