@@ -21,6 +21,16 @@ inline Camera OcamFisheye() {
   return Camera::Ocam(848, 800, 423.714757, 390.949324, 0.999134, -0.000325, -0.000071, kOcamDirect, kOcamInverse);
 }
 
+// OpenCV calibrations of a wide laparoscope, 640x480, about 100° across: five coefficients (a
+// strong barrel: the corners' rays, 57° off the axis, land 28 % nearer the centre than a pinhole
+// would put them), and the rational model's eight.
+inline Camera OpenCvLaparoscope() {
+  return Camera::OpenCv(640, 480, 360.0, 362.5, 322.4, 236.8, {-0.30, 0.10, 0.0008, -0.0006, -0.01});
+}
+inline Camera OpenCvRational() {
+  return Camera::OpenCv(640, 480, 360.0, 362.5, 322.4, 236.8, {0.2, 0.01, 0.0008, -0.0006, 0.0005, 0.4, 0.02, 0.001});
+}
+
 // A Kannala–Brandt camera written in OCamCalib's terms: f·r(θ) expanded about θ = π/2 is an
 // exact inverse polynomial, the direct one is fitted, fy / fx is the affine c.
 inline Camera OcamFromKannalaBrandt(const Camera& kb) {

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <functional>
 
+#include <opencv2/calib3d.hpp>
+
 #include "camera_fixtures.h"
 #include "temp_folder.h"
 #include "nrslam/camera/camera.h"
@@ -26,6 +28,11 @@ Camera EndomapperLike() {
                                Eigen::Vector4d(-0.1389272, -0.001239606, 0.0009125824, -4.071615e-05));
 }
 
+std::filesystem::path WriteText(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream(file) << text;
+  return file;
+}
+
 class CameraModels : public ::testing::TestWithParam<int> {
  protected:
   Camera camera() const {
@@ -33,7 +40,9 @@ class CameraModels : public ::testing::TestWithParam<int> {
       case 0: return Pinhole();
       case 1: return SimFisheye();
       case 2: return EndomapperLike();
-      default: return OcamFisheye();
+      case 3: return OcamFisheye();
+      case 4: return OpenCvLaparoscope();
+      default: return OpenCvRational();
     }
   }
 };
@@ -97,7 +106,85 @@ TEST_P(CameraModels, JsonRoundTrip) {
   EXPECT_EQ(back.params(), cam.params());
 }
 
-INSTANTIATE_TEST_SUITE_P(PinholeFisheyeAndOcam, CameraModels, ::testing::Values(0, 1, 2, 3));
+INSTANTIATE_TEST_SUITE_P(EveryModel, CameraModels, ::testing::Values(0, 1, 2, 3, 4, 5));
+
+// OpenCV itself is the reference for its model: cv::projectPoints for the projection and
+// cv::undistortPoints (iterated to convergence) for the unprojection.
+TEST(OpenCvModel, ProjectsAndUnprojectsAsOpenCvDoes) {
+  for (const Camera& camera : {OpenCvLaparoscope(), OpenCvRational()}) {
+    const std::vector<double>& p = camera.params();
+    const cv::Matx33d k(p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
+    const std::vector<double> distortion(p.begin() + OpenCvModel::kDistortionOffset, p.end());
+    std::vector<cv::Point3d> points;
+    for (int i = 0; i < 200; ++i) {
+      // Up to 55° off the axis, 5–100 mm deep.
+      const double angle = 0.96 * (i % 20) / 19.0, azimuth = 0.37 * i, depth = 5 + i * 0.47;
+      points.emplace_back(depth * std::tan(angle) * std::cos(azimuth), depth * std::tan(angle) * std::sin(azimuth),
+                          depth);
+    }
+    std::vector<cv::Point2d> expected;
+    cv::projectPoints(points, cv::Vec3d::all(0), cv::Vec3d::all(0), k, distortion, expected);
+    std::vector<cv::Point2d> normalised;
+    cv::undistortPoints(expected, normalised, k, distortion, cv::noArray(), cv::noArray(),
+                        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 1000, 1e-15));
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d point(points[i].x, points[i].y, points[i].z);
+      const auto pixel = camera.Project(point);
+      ASSERT_TRUE(pixel.has_value()) << point.transpose();
+      EXPECT_LT((*pixel - Eigen::Vector2d(expected[i].x, expected[i].y)).norm(), 1e-9) << point.transpose();
+      const Eigen::Vector3d ray = camera.Unproject(*pixel);
+      EXPECT_LT((ray - point.normalized()).norm(), 1e-10) << point.transpose();
+      EXPECT_LT((ray / ray.z() - Eigen::Vector3d(normalised[i].x, normalised[i].y, 1)).norm(), 1e-7)
+          << point.transpose();
+    }
+  }
+}
+
+TEST(OpenCvModel, WithoutDistortionItIsThePinholeCamera) {
+  const Camera plain = Camera::OpenCv(640, 480, 320.0, 318.0, 319.5, 239.5, {0, 0, 0, 0, 0});
+  const Camera pinhole = Pinhole();
+  EXPECT_EQ(plain.max_theta(), pinhole.max_theta());
+  for (const Eigen::Vector3d& point : {Eigen::Vector3d(0.1, -0.2, 2.0), Eigen::Vector3d(-3.0, 1.0, 4.0),
+                                      Eigen::Vector3d(40.0, 30.0, 1.0)}) {
+    EXPECT_LT((*plain.Project(point) - *pinhole.Project(point)).norm(), 1e-10);
+    const Eigen::Vector2d pixel = *pinhole.Project(point);
+    EXPECT_LT((plain.Unproject(pixel) - pinhole.Unproject(pixel)).norm(), 1e-12);
+  }
+}
+
+// Past the fold of its radial distortion the model is not one-to-one: such directions are
+// outside the field of view, and pixels beyond the largest radius it reaches get its edge ray.
+TEST(OpenCvModel, TheFieldOfViewEndsWhereTheDistortionFolds) {
+  const Camera camera = OpenCvLaparoscope();
+  // r(1 − 0.3r² + 0.1r⁴ − 0.01r⁶) stops growing at r ≈ 2.28 (66.3°).
+  EXPECT_NEAR(camera.max_theta(), std::atan(2.28), 2e-3);
+  EXPECT_FALSE(camera.Project(Eigen::Vector3d(3.0, 0.0, 1.0)).has_value());
+  const Eigen::Vector3d edge = camera.Unproject(Eigen::Vector2d(camera.cx() + 5 * camera.fx(), camera.cy()));
+  EXPECT_NEAR(std::acos(edge.z()), camera.max_theta(), 1e-9);
+  EXPECT_GT(edge.x(), 0.0);
+}
+
+TEST(OpenCvModel, WrongCalibrationsAreNamed) {
+  const auto message = [](const std::function<Camera()>& make) {
+    try {
+      make().Check();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  // The same lens with a focal length that puts the corners past the fold.
+  EXPECT_NE(message([] { return Camera::OpenCv(640, 480, 200, 200, 319.5, 239.5, {-0.30, 0.10, 0, 0, -0.01}); })
+                .find("folds back inside the image"),
+            std::string::npos);
+  EXPECT_NE(message([] { return Camera::OpenCv(640, 480, 360, 360, 319.5, 239.5, {-0.3, 0.1, 0, 0, 0, 0}); })
+                .find("4, 5 or 8"),
+            std::string::npos);
+  EXPECT_NE(message([] { return Camera::OpenCv(640, 480, 360, 360, 319.5, 239.5, std::vector<double>(14, 0.0)); })
+                .find("tilted"),
+            std::string::npos);
+  EXPECT_EQ(message(OpenCvLaparoscope), "accepted");
+}
 
 TEST(Fisheye, SimulatorLensCoversAtLeast160DegreesAndRoundTripsAtItsEdge) {
   const Camera cam = SimFisheye();
@@ -223,10 +310,7 @@ TEST(Ocam, WithoutAnInversePolynomialOneIsFittedToTheDirectOne) {
 TEST(Ocam, CalibResultsTxtIsReadAsOCamCalibWritesIt) {
   const auto folder = UniqueTempFolder("ocam_file");
   std::filesystem::create_directories(folder);
-  const auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(folder / name) << text;
-    return folder / name;
-  };
+  const auto write = [&](const std::string& name, const std::string& text) { return WriteText(folder / name, text); };
   const std::string header =
       "#polynomial coefficients for the DIRECT mapping function (ocam_model.ss in MATLAB). These are used by "
       "cam2world\n\n5 -2.895569e+02 0.000000e+00 1.538894e-03 -3.140320e-06 7.206996e-09 \n\n"
@@ -259,6 +343,78 @@ TEST(Ocam, CalibResultsTxtIsReadAsOCamCalibWritesIt) {
   EXPECT_NE(message(header + tail.substr(0, tail.find("800"))).find((folder / "broken.txt").string()),
             std::string::npos)
       << "the file is named";
+  std::filesystem::remove_all(folder);
+}
+
+// Calibration files as OpenCV's calibration sample (YAML and XML), a stereo rig (the left
+// camera's M1 / D1), cv::fisheye and ROS's camera_info write them.
+TEST(OpenCvModel, CalibrationFilesAreReadAsOpenCvAndRosWriteThem) {
+  const auto folder = UniqueTempFolder("opencv_calibration");
+  std::filesystem::create_directories(folder);
+  const Camera lens = OpenCvLaparoscope();
+  const std::vector<double>& p = lens.params();
+  const cv::Mat k = (cv::Mat_<double>(3, 3) << p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
+  const cv::Mat five = (cv::Mat_<double>(5, 1) << p[4], p[5], p[6], p[7], p[8]);
+  for (const char* name : {"camera.yml", "camera.xml"}) {
+    cv::FileStorage storage((folder / name).string(), cv::FileStorage::WRITE);
+    storage << "calibration_time" << "Fri Dec  4 08:00:00 2026" << "image_width" << 640 << "image_height" << 480
+            << "camera_matrix" << k << "distortion_coefficients" << five << "avg_reprojection_error" << 0.21;
+  }
+  for (const char* name : {"camera.yml", "camera.xml"}) {
+    const Camera read = ReadCameraFile(folder / name);
+    EXPECT_EQ(read.model(), CameraModelId::kOpenCv) << name;
+    EXPECT_EQ(read.params(), lens.params()) << name;
+    EXPECT_EQ(read.width(), 640);
+  }
+  {
+    cv::FileStorage storage((folder / "stereo.yaml").string(), cv::FileStorage::WRITE);
+    const cv::Mat rational = (cv::Mat_<double>(1, 8) << 0.2, 0.01, 0.0008, -0.0006, 0.0005, 0.4, 0.02, 0.001);
+    storage << "image_size" << cv::Size(640, 480) << "M1" << k << "D1" << rational << "M2" << k << "D2" << rational;
+  }
+  EXPECT_EQ(ReadCameraFile(folder / "stereo.yaml").params(), OpenCvRational().params());
+  {
+    cv::FileStorage storage((folder / "fisheye.yml").string(), cv::FileStorage::WRITE);
+    storage << "image_width" << 720 << "image_height" << 540 << "distortion_model" << "equidistant"
+            << "K" << (cv::Mat_<double>(3, 3) << 358.6052, 0, 367.6783, 0, 358.7408, 276.3991, 0, 0, 1)
+            << "D" << (cv::Mat_<double>(4, 1) << -0.1389272, -0.001239606, 0.0009125824, -4.071615e-05);
+  }
+  const Camera fisheye = ReadCameraFile(folder / "fisheye.yml");
+  EXPECT_EQ(fisheye.model(), CameraModelId::kKannalaBrandt);
+  EXPECT_EQ(fisheye.params(), EndomapperLike().params());
+
+  const auto write = [&](const std::string& name, const std::string& text) { return WriteText(folder / name, text); };
+  const std::string ros =
+      "image_width: 640\nimage_height: 480\ncamera_name: laparoscope_left\n"
+      "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [360.0, 0.0, 322.4, 0.0, 362.5, 236.8, 0.0, 0.0, 1.0]\n"
+      "distortion_model: plumb_bob\n"
+      "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [-0.30, 0.10, 0.0008, -0.0006, -0.01]\n"
+      "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n";
+  EXPECT_EQ(ReadCameraFile(write("ros.yaml", ros)).params(), lens.params());
+  std::string plain = ros;
+  plain.replace(plain.find("[-0.30"), plain.find("]\nrect") - plain.find("[-0.30"), "[0, 0, 0, 0, 0");
+  EXPECT_EQ(ReadCameraFile(write("plain.yaml", plain)).model(), CameraModelId::kPinhole);
+
+  const auto message = [&](const std::string& text) {
+    try {
+      ReadCameraFile(write("broken.yaml", text));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  std::string four = ros;
+  four.replace(four.find("distortion_model: plumb_bob\n"), 28, "");
+  four.replace(four.find(", -0.01]"), 8, "]");
+  EXPECT_NE(message(four).find("say which with distortion_model"), std::string::npos);
+  EXPECT_NE(message(ros.substr(ros.find("camera_name"))).find("no image size"), std::string::npos);
+  std::string skewed = ros;
+  skewed.replace(skewed.find("360.0, 0.0"), 10, "360.0, 0.5");
+  EXPECT_NE(message(skewed).find("no skew"), std::string::npos);
+  std::string unknown = ros;
+  unknown.replace(unknown.find("plumb_bob"), 9, "division");
+  EXPECT_NE(message(unknown).find("unknown distortion_model 'division'"), std::string::npos);
+  EXPECT_NE(message("image_width: [640\n").find((folder / "broken.yaml").string()), std::string::npos)
+      << "a file OpenCV cannot parse is named";
   std::filesystem::remove_all(folder);
 }
 

@@ -39,7 +39,8 @@ void ExpectGradientsMatch(const ceres::CostFunction& cost, const std::vector<con
 std::vector<Camera> Cameras() {
   SimCameraOptions fisheye;
   fisheye.model = "fisheye";
-  return {Camera::Pinhole(640, 480, 320, 318, 319.5, 239.5), MakeSimCamera(fisheye), OcamFisheye()};
+  return {Camera::Pinhole(640, 480, 320, 318, 319.5, 239.5), MakeSimCamera(fisheye), OcamFisheye(), OpenCvLaparoscope(),
+          OpenCvRational()};
 }
 
 TEST(ReprojectionCost, GradientsAtRandomPointsForEveryCameraModel) {
@@ -49,8 +50,9 @@ TEST(ReprojectionCost, GradientsAtRandomPointsForEveryCameraModel) {
     for (int trial = 0; trial < 20; ++trial) {
       PoseParams pose = RandomPose(rng);
       const Rigid3 cam_from_world = Rigid3::FromParams(pose.data());
-      // A point 1–5 units in front, within ±35° (pinhole) / ±70° (fisheye) of the axis.
-      const double reach = camera.model() == CameraModelId::kPinhole ? 0.7 : 2.5;
+      // A point 1–5 units in front, within ±35° (pinhole, OpenCV) / ±70° (fisheye) of the axis.
+      const bool fisheye = camera.model() == CameraModelId::kKannalaBrandt || camera.model() == CameraModelId::kOcam;
+      const double reach = fisheye ? 2.5 : 0.7;
       const Eigen::Vector3d in_camera = rng.Uniform(1, 5) * Eigen::Vector3d(rng.Uniform(-reach, reach) * 0.5,
                                                                               rng.Uniform(-reach, reach) * 0.5, 1.0);
       Eigen::Vector3d point = cam_from_world.Inverse() * in_camera;

@@ -663,31 +663,49 @@ TEST(MonocularRun, RigidSceneGivesAnAccurateGrowingMap) {
   EXPECT_EQ(outcome.deformable_dba, 0);
 }
 
-// A lens given as OCamCalib's model (the simulator's fisheye rewritten in its terms, which the
-// simulator then renders with) through the whole monocular system: the model's projection, its
-// Jacobian and its unprojection are all on the path.
-TEST(MonocularRun, AnOcamCalibratedLensIsTrackedToTheEnd) {
-  const fs::path folder = UniqueTempFolder("nrslam_monocular_ocam");
+// sim-0 (60 frames, 320x240) rendered through a calibration file and run through the whole
+// monocular system: the model's projection, its Jacobian and its unprojection are all on the path.
+RunSummary RunThroughCalibratedLens(const std::string& name, SimCameraOptions camera, const Camera& lens) {
+  const fs::path folder = UniqueTempFolder("nrslam_monocular_" + name);
   fs::remove_all(folder);
   fs::create_directories(folder);
   SimOptions sim = SimPreset("sim-0");
   sim.frames = 60;
-  sim.camera.model = "fisheye";
-  sim.camera.width = 320;
-  sim.camera.height = 240;
-  std::ofstream(folder / "ocam.json") << nlohmann::json(OcamFromKannalaBrandt(MakeSimCamera(sim.camera))).dump();
-  sim.camera.calibration = (folder / "ocam.json").string();
-  SimulateSequence(sim, "sim-0-ocam", folder / "sequence");
-  ASSERT_EQ(SequenceReader(folder / "sequence").info().camera.model(), CameraModelId::kOcam);
+  sim.camera = camera;
+  std::ofstream(folder / "lens.json") << nlohmann::json(lens).dump();
+  sim.camera.calibration = (folder / "lens.json").string();
+  SimulateSequence(sim, "sim-0-" + name, folder / "sequence");
+  EXPECT_EQ(SequenceReader(folder / "sequence").info().camera.model(), lens.model());
   SystemOptions options;  // 320x240: the count thresholds scale down, as for the pinhole run above
   options.initialisation.min_tracks = 50;
   options.initialisation.min_points = 50;
   const RunSummary summary = RunSequence(folder / "sequence", options, folder / "run");
-  std::cout << "sim-0 through an OCam lens, 320x240: init at " << summary.init_frame << ", RMSE " << summary.rmse_mm
-            << " mm (a flat map: " << summary.rmse_flat_mm << " mm)\n";
+  std::cout << "sim-0 through the " << lens.model_name() << " lens, 320x240: init at " << summary.init_frame
+            << ", RMSE " << summary.rmse_mm << " mm (a flat map: " << summary.rmse_flat_mm << " mm)\n";
+  fs::remove_all(folder);
+  return summary;
+}
+
+// The simulator's fisheye rewritten as OCamCalib's model, which the simulator then renders with.
+TEST(MonocularRun, AnOcamCalibratedLensIsTrackedToTheEnd) {
+  SimCameraOptions fisheye;
+  fisheye.model = "fisheye";
+  fisheye.width = 320;
+  fisheye.height = 240;
+  const RunSummary summary = RunThroughCalibratedLens("ocam", fisheye, OcamFromKannalaBrandt(MakeSimCamera(fisheye)));
   ExpectInitialisedAndTrackedToTheEnd(summary);
   EXPECT_LT(summary.rmse_mm, 0.3 * summary.rmse_flat_mm);
-  fs::remove_all(folder);
+}
+
+// A laparoscope calibrated with OpenCV (the fixture's strong barrel, at half its resolution).
+TEST(MonocularRun, AnOpenCvCalibratedLensIsTrackedToTheEnd) {
+  const Camera full = OpenCvLaparoscope();
+  const std::vector<double>& p = full.params();
+  const Camera half = Camera::OpenCv(320, 240, p[0] / 2, p[1] / 2, (p[2] + 0.5) / 2 - 0.5, (p[3] + 0.5) / 2 - 0.5,
+                                     std::vector<double>(p.begin() + OpenCvModel::kDistortionOffset, p.begin() + 9));
+  const RunSummary summary = RunThroughCalibratedLens("opencv", SimCameraOptions(), half);
+  ExpectInitialisedAndTrackedToTheEnd(summary);
+  EXPECT_LT(summary.rmse_mm, 0.3 * summary.rmse_flat_mm);
 }
 
 TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {

@@ -36,7 +36,42 @@ Camera Camera::KannalaBrandt(int width, int height, double fx, double fy, double
   return camera;
 }
 
+Camera Camera::OpenCv(int width, int height, double fx, double fy, double cx, double cy,
+                      const std::vector<double>& distortion) {
+  const size_t count = distortion.size();
+  if (count != 4 && count != 5 && count != 8) {
+    std::ostringstream text;
+    text << "camera: opencv needs 4, 5 or 8 distortion coefficients (OpenCV's order: k1 k2 p1 p2 [k3 [k4 k5 k6]]), got "
+         << count;
+    if (count == 12 || count == 14) text << " (the thin-prism and tilted models are not supported)";
+    throw Error(text.str());
+  }
+  Camera camera;
+  camera.model_ = CameraModelId::kOpenCv;
+  camera.width_ = width;
+  camera.height_ = height;
+  camera.params_ = {fx, fy, cx, cy};
+  camera.params_.insert(camera.params_.end(), distortion.begin(), distortion.end());
+  camera.params_.resize(OpenCvModel::kNumParams, 0.0);
+  camera.ComputeMaxTheta();
+  return camera;
+}
+
 namespace {
+
+// The first angle (rad, in steps of 1e-3 up to `end`) past which radius(θ) stops growing: beyond
+// it two angles would share a pixel.
+template <typename Radius>
+double MonotonicLimit(Radius radius, double end) {
+  constexpr double kStep = 1e-3;
+  double previous = 0.0;
+  for (double theta = kStep; theta < end; theta += kStep) {
+    const double r = radius(theta);
+    if (!(r > previous)) return theta - kStep;
+    previous = r;
+  }
+  return end;
+}
 
 // What OCamCalib's findinvpoly does for a calibration that gives only ss: the inverse
 // polynomial least-squares fitted to the direct one's rays out to the image's farthest corner,
@@ -127,22 +162,19 @@ void Camera::ComputeMaxTheta() {
     if (!std::isfinite(max_theta_)) max_theta_ = 0.0;
     return;
   }
-  if (model_ == CameraModelId::kPinhole || params_.size() != KannalaBrandtModel::kNumParams) {
+  if (model_ == CameraModelId::kPinhole || params_.size() != VisitCameraModel(model_, [](auto model) {
+        return size_t{decltype(model)::kNumParams};
+      })) {
     max_theta_ = M_PI / 2;
     return;
   }
-  // Walk r(θ) until it stops increasing: beyond that two angles share a pixel.
-  constexpr double kStep = 1e-3;
-  double previous = 0.0;
-  max_theta_ = M_PI;
-  for (double theta = kStep; theta <= M_PI; theta += kStep) {
-    const double r = KannalaBrandtModel::Distort(params_.data(), theta);
-    if (r <= previous) {
-      max_theta_ = theta - kStep;
-      return;
-    }
-    previous = r;
+  if (model_ == CameraModelId::kOpenCv) {
+    max_theta_ = MonotonicLimit(
+        [&](double theta) { return OpenCvModel::RadialDistort(params_.data(), std::tan(theta)); }, M_PI / 2);
+    return;
   }
+  max_theta_ =
+      MonotonicLimit([&](double theta) { return KannalaBrandtModel::Distort(params_.data(), theta); }, M_PI);
 }
 
 std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& point) const {
@@ -158,12 +190,18 @@ Eigen::Vector3d Camera::Unproject(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector3d bearing = VisitCameraModel(
       model_, [&](auto model) { return decltype(model)::Unproject(params_.data(), pixel.x(), pixel.y()); });
   // Pinhole rays cover the plane; OCam's max_theta() is the image border's widest ray.
-  if (model_ != CameraModelId::kKannalaBrandt) return bearing;
-  // Pixels beyond the image circle (past the largest r(θ) the lens reaches) have no ray;
-  // give them the ray at the edge of the field of view in their direction.
+  if (model_ == CameraModelId::kPinhole || model_ == CameraModelId::kOcam) return bearing;
+  // Pixels beyond the largest distorted radius the lens reaches have no ray; give them the ray at
+  // the edge of the field of view in their direction.
   const double mx = (pixel.x() - cx()) / fx(), my = (pixel.y() - cy()) / fy();
   const double radius = std::hypot(mx, my);
-  if (radius <= KannalaBrandtModel::Distort(params_.data(), max_theta_)) return bearing;
+  if (model_ == CameraModelId::kKannalaBrandt) {
+    if (radius <= KannalaBrandtModel::Distort(params_.data(), max_theta_)) return bearing;
+  } else {
+    // The tangential terms move the reach off a circle: trust Newton's ray if it lands on the pixel.
+    const std::optional<Eigen::Vector2d> back = Project(bearing);
+    if (back && (*back - pixel).norm() < 1e-6) return bearing;
+  }
   return Eigen::Vector3d(std::sin(max_theta_) * mx / radius, std::sin(max_theta_) * my / radius, std::cos(max_theta_));
 }
 
@@ -209,6 +247,30 @@ void Camera::Check() const {
     fail(text.str());
   }
   if (model_ == CameraModelId::kOcam) CheckOcam();
+  if (model_ == CameraModelId::kOpenCv) CheckOpenCv();
+}
+
+void Camera::CheckOpenCv() const {
+  // Every pixel of the image must have its own ray: the distortion must not fold back inside it.
+  constexpr int kGrid = 8;
+  const auto check = [&](int x, int y) {
+    const Eigen::Vector2d pixel(x, y);
+    const Eigen::Vector3d ray = Unproject(pixel);
+    const std::optional<Eigen::Vector2d> back = Project(ray);
+    if (!back || (*back - pixel).norm() > 1e-3 || std::acos(std::min(1.0, ray.z())) >= max_theta_ - 1e-9) {
+      std::ostringstream text;
+      text << "camera: opencv: the distortion folds back inside the image near pixel (" << x << ", " << y
+           << "), so pixels there have no ray (coefficients in OpenCV's order k1 k2 p1 p2 k3 k4 k5 k6? for this "
+              "image size?)";
+      throw Error(text.str());
+    }
+  };
+  for (int y = 0; y < height_; y += kGrid) {
+    for (int x = 0; x < width_; x += kGrid) check(x, y);
+    check(width_ - 1, y);
+  }
+  for (int x = 0; x < width_; x += kGrid) check(x, height_ - 1);
+  check(width_ - 1, height_ - 1);
 }
 
 void Camera::CheckOcam() const {
@@ -275,6 +337,11 @@ void to_json(nlohmann::json& j, const Camera& camera) {
   j["fx"] = camera.fx();
   j["fy"] = camera.fy();
   if (camera.model() == CameraModelId::kKannalaBrandt) j["k"] = {p[4], p[5], p[6], p[7]};
+  if (camera.model() == CameraModelId::kOpenCv) {
+    const auto first = p.begin() + OpenCvModel::kDistortionOffset;
+    const bool rational = p[9] != 0.0 || p[10] != 0.0 || p[11] != 0.0;
+    j["distortion"] = std::vector<double>(first, first + (rational ? 8 : 5));
+  }
 }
 
 void from_json(const nlohmann::json& j, Camera& camera) {
@@ -309,8 +376,13 @@ void from_json(const nlohmann::json& j, Camera& camera) {
       }
       const auto k = j.at("k").get<std::vector<double>>();
       camera = Camera::KannalaBrandt(width, height, fx, fy, cx, cy, Eigen::Vector4d(k[0], k[1], k[2], k[3]));
+    } else if (model == OpenCvModel::kName) {
+      if (!j.contains("distortion") || !j.at("distortion").is_array()) {
+        throw Error("camera: opencv needs 'distortion': OpenCV's distCoeffs, k1 k2 p1 p2 [k3 [k4 k5 k6]]");
+      }
+      camera = Camera::OpenCv(width, height, fx, fy, cx, cy, j.at("distortion").get<std::vector<double>>());
     } else {
-      throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt, ocam)");
+      throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt, opencv, ocam)");
     }
   } catch (const nlohmann::json::exception& e) {
     throw Error(std::string("camera: malformed field: ") + e.what());

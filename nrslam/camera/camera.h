@@ -18,6 +18,10 @@ class Camera {
   static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
   static Camera KannalaBrandt(int width, int height, double fx, double fy, double cx, double cy,
                               const Eigen::Vector4d& k);
+  // OpenCV's radial-tangential model (camera_models.h) with OpenCV's distCoeffs: 4 (k1 k2 p1 p2),
+  // 5 (… k3) or 8 (… k4 k5 k6, the rational model) of them; other counts throw Error.
+  static Camera OpenCv(int width, int height, double fx, double fy, double cx, double cy,
+                       const std::vector<double>& distortion);
   // OCamCalib's model (camera_models.h): centre at column cx, row cy; `direct` is ss and
   // `inverse` is invpol, lowest order first, at most OcamModel::kMaxDirect / kMaxInverse terms.
   // An empty `inverse` is fitted to `direct` over the image (calibrations that give only ss).
@@ -35,14 +39,16 @@ class Camera {
   double cy() const { return params_[3]; }
 
   // Largest angle from the optical axis the model maps one-to-one (rad): π/2 for pinhole,
-  // the end of the monotonic part of r(θ) for Kannala–Brandt (at most π), the widest ray of
-  // the image's border for OCam (its polynomials are fitted over the image only).
+  // the end of the monotonic part of r(θ) for Kannala–Brandt (at most π) and of the radial
+  // distortion for OpenCV's model (at most π/2), the widest ray of the image's border for OCam
+  // (its polynomials are fitted over the image only).
   double max_theta() const { return max_theta_; }
 
   // Pixel of a point in camera coordinates; nullopt when the point is behind the camera
   // or outside the model's field of view. The pixel may still lie outside the image.
   std::optional<Eigen::Vector2d> Project(const Eigen::Vector3d& point) const;
-  // Unit bearing of a pixel; beyond a fisheye's image circle, the bearing at max_theta().
+  // Unit bearing of a pixel; beyond what the distortion reaches (a fisheye's image circle), the
+  // bearing at max_theta().
   Eigen::Vector3d Unproject(const Eigen::Vector2d& pixel) const;
   // d pixel / d point at `point` (camera coordinates).
   Eigen::Matrix<double, 2, 3> ProjectionJacobian(const Eigen::Vector3d& point) const;
@@ -65,6 +71,7 @@ class Camera {
   double max_theta_ = 0.0;
   void ComputeMaxTheta();
   void CheckOcam() const;
+  void CheckOpenCv() const;
 };
 
 void to_json(nlohmann::json& j, const Camera& camera);

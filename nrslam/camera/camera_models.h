@@ -6,13 +6,16 @@
 // every model, so consumers never need to know which model produced a ray.
 #pragma once
 
+#include <ceres/jet.h>
+
 #include <Eigen/Core>
+#include <Eigen/LU>
 
 #include <cmath>
 
 namespace nrslam {
 
-enum class CameraModelId { kPinhole, kKannalaBrandt, kOcam };
+enum class CameraModelId { kPinhole, kKannalaBrandt, kOcam, kOpenCv };
 
 // params = [fx, fy, cx, cy]
 struct PinholeModel {
@@ -87,6 +90,74 @@ struct KannalaBrandtModel {
     }
     const double s = std::sin(theta) / theta_d;
     return Eigen::Vector3d(s * mx, s * my, std::cos(theta));
+  }
+};
+
+// OpenCV's pinhole model with radial-tangential (Brown–Conrady) distortion, as
+// cv::calibrateCamera returns it: the model of most laparoscope and endoscope calibrations.
+// params = [fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6] (OpenCV's distCoeffs order; a
+// calibration with 4 or 5 coefficients leaves the rest 0, the rational model uses k4…k6).
+// With (x, y) = (X/Z, Y/Z) and r² = x² + y²:
+//   x' = x·R + 2p1·xy + p2(r² + 2x²),  y' = y·R + p1(r² + 2y²) + 2p2·xy,
+//   R = (1 + k1r² + k2r⁴ + k3r⁶) / (1 + k4r² + k5r⁴ + k6r⁶),   u = fx·x' + cx, v = fy·y' + cy.
+struct OpenCvModel {
+  static constexpr CameraModelId kId = CameraModelId::kOpenCv;
+  static constexpr int kNumParams = 12;
+  static constexpr int kDistortionOffset = 4;
+  static constexpr const char* kName = "opencv";
+
+  // (x', y') of the undistorted normalised point (x, y).
+  template <typename T>
+  static void Distort(const double* params, const T& x, const T& y, T* distorted) {
+    const double k1 = params[4], k2 = params[5], p1 = params[6], p2 = params[7];
+    const double k3 = params[8], k4 = params[9], k5 = params[10], k6 = params[11];
+    const T r2 = x * x + y * y;
+    const T radial = (T(1) + r2 * (k1 + r2 * (k2 + r2 * k3))) / (T(1) + r2 * (k4 + r2 * (k5 + r2 * k6)));
+    const T xy = x * y;
+    distorted[0] = x * radial + T(2 * p1) * xy + p2 * (r2 + T(2) * x * x);
+    distorted[1] = y * radial + p1 * (r2 + T(2) * y * y) + T(2 * p2) * xy;
+  }
+
+  // Distance from the axis, in the normalised image, of a point r from it without distortion
+  // (the radial part alone): where it stops growing, two rays share a pixel.
+  static double RadialDistort(const double* params, double r) {
+    const double r2 = r * r;
+    return r * (1 + r2 * (params[4] + r2 * (params[5] + r2 * params[8]))) /
+           (1 + r2 * (params[9] + r2 * (params[10] + r2 * params[11])));
+  }
+
+  // False for points at or behind the image plane; whether the point is inside the field of
+  // view the distortion is defined over is the Camera's business (Camera::max_theta()).
+  template <typename T>
+  static bool Project(const double* params, const T* point, T* pixel) {
+    if (!(point[2] > T(0))) return false;
+    const T inverse_z = T(1) / point[2];
+    T distorted[2];
+    Distort(params, point[0] * inverse_z, point[1] * inverse_z, distorted);
+    pixel[0] = params[0] * distorted[0] + params[2];
+    pixel[1] = params[1] * distorted[1] + params[3];
+    return true;
+  }
+
+  // Newton's method on the distortion, from the distorted point itself. Pixels the distortion
+  // does not reach (beyond its fold) give whatever the iteration ends at; Camera::Unproject
+  // catches them.
+  static Eigen::Vector3d Unproject(const double* params, double u, double v) {
+    using Jet = ceres::Jet<double, 2>;
+    const Eigen::Vector2d target((u - params[2]) / params[0], (v - params[3]) / params[1]);
+    Eigen::Vector2d undistorted = target;
+    for (int iteration = 0; iteration < 30; ++iteration) {
+      Jet distorted[2];
+      Distort(params, Jet(undistorted.x(), 0), Jet(undistorted.y(), 1), distorted);
+      Eigen::Matrix2d jacobian;
+      jacobian << distorted[0].v.transpose(), distorted[1].v.transpose();
+      const Eigen::Vector2d step =
+          jacobian.inverse() * (Eigen::Vector2d(distorted[0].a, distorted[1].a) - target);
+      if (!step.allFinite()) break;
+      undistorted -= step;
+      if (step.norm() < 1e-15 * (1 + undistorted.norm())) break;
+    }
+    return Eigen::Vector3d(undistorted.x(), undistorted.y(), 1.0).normalized();
   }
 };
 
@@ -202,6 +273,8 @@ decltype(auto) VisitCameraModel(CameraModelId id, Function&& f) {
       return f(KannalaBrandtModel{});
     case CameraModelId::kOcam:
       return f(OcamModel{});
+    case CameraModelId::kOpenCv:
+      return f(OpenCvModel{});
     case CameraModelId::kPinhole:
     default:
       return f(PinholeModel{});

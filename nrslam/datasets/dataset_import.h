@@ -13,8 +13,8 @@
 //   images          a folder of images (sorted by name) or a video file, with a calibration
 //                   file; no ground truth (runs need monocular initialisation).
 //
-// A calibration file is a JSON camera as in sequence.json ("model", "width", "height", "fx",
-// "fy", "cx", "cy", and "k" for kannala_brandt).
+// A calibration file is whatever io/camera_file.h reads: a JSON camera as in sequence.json,
+// OCamCalib's calib_results.txt or an OpenCV / ROS calibration (YAML or XML).
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,9 @@
 #include "nrslam/io/camera_file.h"
 
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -37,7 +41,109 @@ std::vector<double> Exactly(size_t count, const std::string& line, const std::st
   return numbers;
 }
 
+// The numbers of an OpenCV calibration entry: a list, or a map holding them under "data" (an
+// opencv-matrix, ROS's {rows, cols, data}).
+std::vector<double> EntryNumbers(const cv::FileNode& node, const std::string& key) {
+  if (node.isReal() || node.isInt()) return {static_cast<double>(node)};
+  const cv::FileNode list = node.isMap() ? node["data"] : node;
+  if (!list.isSeq()) throw Error("'" + key + "' is neither a list of numbers nor a matrix with 'data'");
+  std::vector<double> numbers;
+  for (const cv::FileNode& item : list) {
+    if (!item.isReal() && !item.isInt()) throw Error("'" + key + "' holds something that is not a number");
+    numbers.push_back(static_cast<double>(item));
+  }
+  return numbers;
+}
+
+// The first of `keys` the file has: its key and node; an empty key when none is there.
+std::pair<std::string, cv::FileNode> FirstEntry(const cv::FileStorage& storage, std::initializer_list<const char*> keys) {
+  for (const char* key : keys) {
+    const cv::FileNode node = storage[key];
+    if (!node.empty() && !node.isNone()) return {key, node};
+  }
+  return {"", cv::FileNode()};
+}
+
+std::string Lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+bool IsOpenCvCalibration(const std::filesystem::path& file, char first) {
+  const std::string extension = Lowercase(file.extension().string());
+  return first == '%' || first == '<' || extension == ".yml" || extension == ".yaml" || extension == ".xml";
+}
+
 }  // namespace
+
+Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  std::string contents = text.str();
+  // OpenCV's YAML reader wants the version directive its writer puts first; ROS leaves it out.
+  const size_t first = contents.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && contents[first] != '%' && contents[first] != '<') {
+    contents = "%YAML:1.0\n---\n" + contents;
+  }
+  cv::FileStorage storage;
+  try {
+    storage.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  } catch (const cv::Exception& e) {
+    throw Error("not a calibration OpenCV can read (YAML or XML): " + e.err);
+  }
+  if (!storage.isOpened()) throw Error("OpenCV cannot open it as a calibration (YAML or XML)");
+  const auto [matrix_key, matrix_node] = FirstEntry(storage, {"camera_matrix", "cameraMatrix", "K", "M1"});
+  if (matrix_key.empty()) throw Error("no camera matrix (camera_matrix, cameraMatrix, K or M1)");
+  const std::vector<double> k = EntryNumbers(matrix_node, matrix_key);
+  if (k.size() != 9) throw Error("'" + matrix_key + "' must be 3x3, has " + std::to_string(k.size()) + " numbers");
+  if (k[1] != 0.0 || k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0) {
+    throw Error("'" + matrix_key + "' must be [fx 0 cx; 0 fy cy; 0 0 1] (no skew)");
+  }
+
+  int width = 0, height = 0;
+  const auto [size_key, size_node] = FirstEntry(storage, {"image_size", "imageSize"});
+  if (!storage["image_width"].empty() && !storage["image_height"].empty()) {
+    width = static_cast<int>(storage["image_width"]);
+    height = static_cast<int>(storage["image_height"]);
+  } else if (!size_key.empty()) {
+    const std::vector<double> size = EntryNumbers(size_node, size_key);
+    if (size.size() != 2) throw Error("'" + size_key + "' must be [width, height]");
+    width = static_cast<int>(size[0]);
+    height = static_cast<int>(size[1]);
+  } else {
+    throw Error("no image size (image_width and image_height, or image_size): add the size the calibration was made at");
+  }
+
+  const auto [distortion_key, distortion_node] =
+      FirstEntry(storage, {"distortion_coefficients", "dist_coeffs", "distCoeffs", "D", "D1"});
+  std::vector<double> distortion =
+      distortion_key.empty() ? std::vector<double>() : EntryNumbers(distortion_node, distortion_key);
+  const cv::FileNode model_node = storage["distortion_model"];
+  const std::string model = model_node.isString() ? Lowercase(static_cast<std::string>(model_node)) : "";
+  const bool fisheye = model == "equidistant" || model == "fisheye" || model == "kannala_brandt";
+  if (!model.empty() && !fisheye && model != "plumb_bob" && model != "radtan" && model != "rational_polynomial") {
+    throw Error("unknown distortion_model '" + model +
+                "' (known: plumb_bob, radtan, rational_polynomial, equidistant, fisheye, kannala_brandt)");
+  }
+  // ROS writes an empty list for an undistorted camera; 5 zeros are the same camera.
+  const bool undistorted = std::all_of(distortion.begin(), distortion.end(), [](double d) { return d == 0.0; });
+  const double fx = k[0], fy = k[4], cx = k[2], cy = k[5];
+  if (fisheye) {
+    if (distortion.size() != 4) {
+      throw Error("the fisheye (equidistant) model needs 4 coefficients in '" + distortion_key + "', got " +
+                  std::to_string(distortion.size()));
+    }
+    return Camera::KannalaBrandt(width, height, fx, fy, cx, cy,
+                                 Eigen::Vector4d(distortion[0], distortion[1], distortion[2], distortion[3]));
+  }
+  if (model.empty() && distortion.size() == 4) {
+    throw Error("4 distortion coefficients could be OpenCV's k1 k2 p1 p2 or its fisheye model's k1 k2 k3 k4: say "
+                "which with distortion_model: plumb_bob or distortion_model: equidistant");
+  }
+  if (undistorted) return Camera::Pinhole(width, height, fx, fy, cx, cy);
+  return Camera::OpenCv(width, height, fx, fy, cx, cy, distortion);
+}
 
 Camera ParseOcamCalibResults(const std::string& text) {
   std::vector<std::string> lines;
@@ -69,6 +175,11 @@ Camera ReadCameraFile(const std::filesystem::path& file) {
   try {
     char first = 0;
     if (!std::filesystem::is_directory(file)) std::ifstream(file) >> first;
+    if (first != 0 && IsOpenCvCalibration(file, first)) {
+      Camera camera = ReadOpenCvCalibration(file);
+      camera.Check();
+      return camera;
+    }
     if (first != 0 && first != '{') {
       // Not a JSON object: OCamCalib's text format.
       std::ifstream stream(file);

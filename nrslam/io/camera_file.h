@@ -1,6 +1,8 @@
 // io: a camera calibration on its own: a JSON file holding what sequence.json's "camera" holds
-// (model, width, height, cx, cy, and fx, fy, k or the ocam fields), a whole sequence.json, whose
-// "camera" is then read, or OCamCalib's calib_results.txt (the Scaramuzza model, `ocam`).
+// (model, width, height, cx, cy, and fx, fy, k, distortion or the ocam fields), a whole
+// sequence.json, whose "camera" is then read, OCamCalib's calib_results.txt (the Scaramuzza
+// model, `ocam`), or an OpenCV calibration file (cv::FileStorage YAML or XML, as OpenCV's
+// calibration tools and ROS's camera_info write them).
 #pragma once
 
 #include <filesystem>
@@ -18,5 +20,18 @@ Camera ReadCameraFile(const std::filesystem::path& file);
 // centre (row, column), the affine part (c, d, e) and the image size (height, width). Throws
 // Error naming the part that is wrong.
 Camera ParseOcamCalibResults(const std::string& text);
+
+// A calibration as cv::FileStorage reads it (YAML or XML), as OpenCV's calibration sample, ROS's
+// camera_info and many stereo rigs (the left camera's M1 / D1) write it:
+//  - the 3×3 camera matrix: camera_matrix, cameraMatrix, K or M1 (an opencv-matrix, a
+//    {rows, cols, data} map or a list of 9 numbers; no skew);
+//  - the distortion: distortion_coefficients, dist_coeffs, distCoeffs, D or D1; none = pinhole;
+//  - the image size: image_width and image_height, or image_size / imageSize as [width, height];
+//  - optionally distortion_model: plumb_bob, radtan or rational_polynomial (OpenCV's model,
+//    `opencv`, 4, 5 or 8 coefficients), or equidistant, fisheye or kannala_brandt (cv::fisheye's
+//    model, `kannala_brandt`, 4 coefficients). Without it 5 or 8 coefficients are OpenCV's
+//    model; 4 are ambiguous between the two and refused.
+// Throws Error naming what is missing or wrong.
+Camera ReadOpenCvCalibration(const std::filesystem::path& file);
 
 }  // namespace nrslam

@@ -24,7 +24,7 @@ struct SimCameraOptions {
   bool stereo = false;            // also render a rectified right camera (pinhole only)
   double baseline_mm = 5.0;       // stereo baseline, mm
   // A calibration file to render with instead of the model above (a camera JSON, a
-  // sequence.json or OCamCalib's calib_results.txt): your own endoscope's lens. Its image size
+  // sequence.json, OCamCalib's calib_results.txt or an OpenCV / ROS calibration): your own lens. Its image size
   // replaces width and height; every pixel whose ray the model defines is rendered.
   std::string calibration;
   void Check() const;

@@ -26,7 +26,7 @@ struct RunOptions {
   bool reinitialise_after_loss = false;
   int first_frame = 0;         // frame range to process, [first_frame, last_frame); -1 = to the end
   int last_frame = -1;
-  std::string camera;          // a camera JSON (as in sequence.json) used instead of the sequence's; "" = its own
+  std::string camera;          // a calibration file (io/camera_file.h) used instead of the sequence's; "" = its own
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunOptions, init, mapping, reinitialise_after_loss, first_frame, last_frame,
