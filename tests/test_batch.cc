@@ -317,6 +317,16 @@ TEST(Sweep, SimulatorOptionsRenderThePresetsAnewPerValue) {
   EXPECT_EQ(plan.runs[1].label, "amplitude_mm=0,k=2");
   EXPECT_EQ(plan.runs[1].point[0], "simulate.deformation.amplitude_mm=0");
   EXPECT_EQ(plan.runs[1].run_folder, std::filesystem::absolute(folder / "out" / "runs" / "s" / "amplitude_mm=0,k=2"));
+  // A value that is a path (a lens to render with) names one folder inside --out, whatever it holds.
+  const EvaluationPlan lenses = PlanEvaluation(
+      manifest, {}, {ParseSweep("simulate.camera.calibration=/data/lens%1.yml,../../outside.yml")}, folder / "out",
+      folder / "cache");
+  ASSERT_EQ(lenses.runs.size(), 4u);
+  EXPECT_EQ(lenses.runs[0].label, "calibration=/data/lens%1.yml");
+  EXPECT_EQ(lenses.runs[0].run_folder,
+            std::filesystem::absolute(folder / "out" / "runs" / "s" / "calibration=%2Fdata%2Flens%251.yml"));
+  EXPECT_EQ(lenses.runs[1].run_folder,
+            std::filesystem::absolute(folder / "out" / "runs" / "s" / "calibration=..%2F..%2Foutside.yml"));
 
   ExpectRefused([] { ParseSweep("simulate.amplitude=1,2"); },
                 "did you mean colon.bend_amplitude_mm or deformation.amplitude_mm?");

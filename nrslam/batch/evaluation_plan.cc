@@ -210,6 +210,15 @@ ManifestSequence WithSimulatorPoint(ManifestSequence sequence, const std::vector
   return sequence;
 }
 
+// The folder a sweep point's runs go to, named by its label. A value can be a path
+// (`--sweep simulate.camera.calibration=/data/lens.yml`): '/' is percent-encoded (and '%', so
+// that two labels never share a folder), so a value neither nests folders nor climbs out of --out.
+std::string LabelFolderName(const std::string& label) {
+  std::string name;
+  for (char c : label) name += c == '/' ? "%2F" : c == '%' ? "%25" : std::string(1, c);
+  return name;
+}
+
 }  // namespace
 
 std::string RunName(const std::string& sequence, const std::string& label) {
@@ -294,7 +303,7 @@ EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::s
       run.prepare = AddPrepare(rendered, cache_folder, &plan);
       run.sequence_folder = run.prepare < 0 ? sequence.path : plan.prepares[run.prepare].folder;
       run.run_folder = out_folder / "runs" / sequence.name;
-      if (!run.label.empty()) run.run_folder /= run.label;
+      if (!run.label.empty()) run.run_folder /= LabelFolderName(run.label);
       std::vector<std::string> assignments = sequence.assignments;
       assignments.insert(assignments.end(), extra.begin(), extra.end());
       for (const std::string& assignment : point) {
