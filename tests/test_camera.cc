@@ -106,6 +106,37 @@ TEST_P(CameraModels, JsonRoundTrip) {
   EXPECT_EQ(back.params(), cam.params());
 }
 
+// A camera resized with its images (halved, as the reference halves Endomapper's video, and
+// scaled unevenly, which rounding to whole pixels can do) sees every ray where the resized
+// image has that ray's pixel.
+TEST_P(CameraModels, ResizedItSeesEachRayWhereTheResizedImageHasIt) {
+  const Camera cam = camera();
+  for (const auto& [width, height] : {std::pair(cam.width() / 2, cam.height() / 2),
+                                      std::pair(static_cast<int>(cam.width() * 0.5), static_cast<int>(cam.height() * 0.6))}) {
+    const Camera resized = cam.Resized(width, height);
+    ASSERT_NO_THROW(resized.Check());
+    EXPECT_EQ(resized.model(), cam.model());
+    const Eigen::Array2d scale(static_cast<double>(width) / cam.width(), static_cast<double>(height) / cam.height());
+    int checked = 0;
+    for (int y = 0; y < cam.height(); y += 7) {
+      for (int x = 0; x < cam.width(); x += 7) {
+        const Eigen::Vector2d pixel(x + 0.25, y + 0.75);
+        const Eigen::Vector3d ray = cam.Unproject(pixel);
+        if (std::acos(ray.z()) > cam.max_theta() - 1e-9) continue;  // beyond the image circle
+        const Eigen::Vector2d expected = ((pixel.array() + 0.5) * scale - 0.5).matrix();
+        if (!resized.InImage(expected)) continue;  // past the resized image's outermost pixel centres
+        const auto projected = resized.Project(20.0 * ray);
+        ASSERT_TRUE(projected.has_value()) << pixel.transpose();
+        ASSERT_LT((*projected - expected).norm(), 1e-6) << pixel.transpose() << " to " << width << "x" << height;
+        ASSERT_LT((resized.Unproject(expected) - ray).norm(), 1e-8) << pixel.transpose();
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, cam.width() * cam.height() / 49 / 2);
+  }
+  EXPECT_THROW(cam.Resized(0, 10), Error);
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryModel, CameraModels, ::testing::Values(0, 1, 2, 3, 4, 5));
 
 // OpenCV itself is the reference for its model: cv::projectPoints for the projection and

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 
 #include "nrslam/datasets/dataset_import.h"
@@ -103,17 +104,22 @@ TEST(DatasetImport, EndomapperSimulatedReversedZDepthAndInvertedPoses) {
   fs::remove_all(out);
 }
 
-TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
-  const fs::path in = UniqueTempFolder("hamlyn_in"), out = UniqueTempFolder("hamlyn_out");
+// A Hamlyn rectified layout: stereo frames, the depth of frame i from depth_mm(i), a baseline.
+void HamlynFixture(const fs::path& in, const std::function<cv::Mat(int)>& depth_mm) {
   for (const char* folder : {"image01", "image02", "depth01"}) fs::create_directories(in / folder);
   for (int i = 0; i < kFrames; ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "%010d.png", i);
     cv::imwrite((in / "image01" / name).string(), Frame(i));
     cv::imwrite((in / "image02" / name).string(), Frame(i + 10));
-    cv::imwrite((in / "depth01" / name).string(), cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)));
+    cv::imwrite((in / "depth01" / name).string(), depth_mm(i));
   }
   std::ofstream(in / "intrinsics.txt") << "50.5 0 31.2\n0 50.7 23.9\n0 0 1\n5.38\n";
+}
+
+TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
+  const fs::path in = UniqueTempFolder("hamlyn_in"), out = UniqueTempFolder("hamlyn_out");
+  HamlynFixture(in, [](int i) { return cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)); });
   ImportOptions options = Options("hamlyn", in);
   ImportDataset(options, out);
   const SequenceReader sequence(out);
@@ -127,6 +133,41 @@ TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
 
   fs::remove(in / "image02" / "0000000001.png");
   EXPECT_NE(ImportError(options, out).find("image02/ has 2 images, image01/ 3"), std::string::npos);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+// --scale resizes the images, the depth and the calibration together (the reference halves
+// Endomapper's video); the depth takes the nearest pixel, so a step stays a step.
+TEST(DatasetImport, ScaleResizesImagesDepthAndCalibrationTogether) {
+  const fs::path in = UniqueTempFolder("scaled_in"), out = UniqueTempFolder("scaled_out");
+  HamlynFixture(in, [](int) {
+    cv::Mat depth(kHeight, kWidth, CV_16UC1, cv::Scalar(60));
+    depth.colRange(kWidth / 2 + 1, kWidth).setTo(90);  // a step edge between two columns pairs average over
+    return depth;
+  });
+  ImportOptions options = Options("hamlyn", in);
+  options.scale = 0.5;
+  ImportDataset(options, out);
+  const SequenceReader sequence(out);
+  const Camera expected = Camera::Pinhole(kWidth, kHeight, 50.5, 50.7, 31.2, 23.9).Resized(kWidth / 2, kHeight / 2);
+  EXPECT_EQ(sequence.info().camera.params(), expected.params());
+  EXPECT_DOUBLE_EQ(sequence.info().camera.fx(), 25.25);
+  EXPECT_DOUBLE_EQ(sequence.info().camera.cx(), 15.35);  // (31.2 + 0.5) / 2 - 0.5
+  EXPECT_EQ(sequence.info().stereo->right_camera.params(), expected.params());
+  EXPECT_DOUBLE_EQ(sequence.info().stereo->baseline_mm, 5.38);  // a length: it does not scale
+  EXPECT_EQ(sequence.ReadRgb(1).size(), cv::Size(kWidth / 2, kHeight / 2));
+  EXPECT_EQ(sequence.ReadRight(1).size(), cv::Size(kWidth / 2, kHeight / 2));
+  const cv::Mat depth = sequence.ReadDepthMm(1);
+  ASSERT_EQ(depth.size(), cv::Size(kWidth / 2, kHeight / 2));
+  for (int x = 0; x < depth.cols; ++x) {
+    const float value = depth.at<float>(5, x);
+    EXPECT_TRUE(value == 60.f || value == 90.f) << "column " << x << " reads " << value;
+  }
+  EXPECT_EQ(sequence.info().provenance.at("scale"), 0.5);
+
+  options.scale = 0;
+  EXPECT_NE(ImportError(options, UniqueTempFolder("scaled_out_2")).find("scale must be in (0, 4]"), std::string::npos);
   fs::remove_all(in);
   fs::remove_all(out);
 }

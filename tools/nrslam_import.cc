@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   app.add_option("--fps", options.fps, "frames per second")->capture_default_str();
   app.add_option("--max-frames", options.max_frames, "import at most this many frames (0 = all)")->capture_default_str();
   app.add_option("--depth-unit-mm", options.depth_unit_mm, "resolution of the written depth, mm")->capture_default_str();
+  app.add_option("--scale", options.scale,
+                 "resize every image, depth map and the calibration by this factor, in (0, 4] (0.5 halves 1440x1080 to 720x540)")
+      ->capture_default_str();
   app.add_option("--near", options.near, "endomapper-sim: near plane, scene units")->capture_default_str();
   app.add_option("--far", options.far, "endomapper-sim: far plane, scene units")->capture_default_str();
   app.add_option("--scene-unit-mm", options.scene_unit_mm, "endomapper-sim: mm per scene unit")->capture_default_str();

@@ -23,7 +23,7 @@ const std::set<std::string> kExternalKeys = {"estimates", "trajectory", "stride"
 
 // The keys of an "import" object: nrslam_import's options by their long names.
 const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
-                                           "depth_unit_mm", "near", "far", "scene_unit_mm"};
+                                           "depth_unit_mm", "near", "far", "scene_unit_mm", "scale"};
 
 void Require(bool condition, const std::string& context, const std::string& message) {
   if (!condition) throw Error(context + ": " + message);

@@ -59,6 +59,13 @@ Camera Camera::OpenCv(int width, int height, double fx, double fy, double cx, do
 
 namespace {
 
+// A polynomial's coefficients from params, without the unused trailing zeros.
+std::vector<double> Coefficients(const std::vector<double>& params, int offset, int count) {
+  auto end = params.begin() + offset + count;
+  while (end > params.begin() + offset + 1 && *(end - 1) == 0.0) --end;
+  return std::vector<double>(params.begin() + offset, end);
+}
+
 // The first angle (rad, in steps of 1e-3 up to `end`) past which radius(θ) stops growing: beyond
 // it two angles would share a pixel.
 template <typename Radius>
@@ -135,6 +142,33 @@ Camera Camera::Ocam(int width, int height, double cx, double cy, double c, doubl
   // fx, fy in the other models' places: ρ'(0) along the columns and the rows.
   camera.params_[0] = OcamModel::InverseDerivative(camera.params_.data(), -M_PI / 2);
   camera.params_[1] = camera.params_[0] * c;
+  camera.ComputeMaxTheta();
+  return camera;
+}
+
+Camera Camera::Resized(int width, int height) const {
+  if (width <= 0 || height <= 0) {
+    throw Error("camera: cannot resize to " + std::to_string(width) + "x" + std::to_string(height));
+  }
+  const double sx = static_cast<double>(width) / width_, sy = static_cast<double>(height) / height_;
+  const double cx_resized = (cx() + 0.5) * sx - 0.5, cy_resized = (cy() + 0.5) * sy - 0.5;
+  if (model_ == CameraModelId::kOcam) {
+    // Scaling OCamCalib's (a, b) plane by sx keeps each pixel's ray if ss and invpol scale with
+    // it (ss_i·sx^(1−i), invpol_i·sx); the affine part takes the rows' extra sy / sx.
+    const std::vector<double>& p = params_;
+    std::vector<double> direct = Coefficients(p, OcamModel::kDirectOffset, OcamModel::kMaxDirect);
+    std::vector<double> inverse = Coefficients(p, OcamModel::kInverseOffset, OcamModel::kMaxInverse);
+    for (size_t i = 0; i < direct.size(); ++i) direct[i] *= std::pow(sx, 1.0 - static_cast<double>(i));
+    for (double& coefficient : inverse) coefficient *= sx;
+    return Ocam(width, height, cx_resized, cy_resized, p[4] * sy / sx, p[5] * sy / sx, p[6], direct, inverse);
+  }
+  Camera camera = *this;
+  camera.width_ = width;
+  camera.height_ = height;
+  camera.params_[0] *= sx;
+  camera.params_[1] *= sy;
+  camera.params_[2] = cx_resized;
+  camera.params_[3] = cy_resized;
   camera.ComputeMaxTheta();
   return camera;
 }
@@ -310,17 +344,6 @@ void Camera::CheckOcam() const {
     }
   }
 }
-
-namespace {
-
-// A polynomial's coefficients from params, without the unused trailing zeros.
-std::vector<double> Coefficients(const std::vector<double>& params, int offset, int count) {
-  auto end = params.begin() + offset + count;
-  while (end > params.begin() + offset + 1 && *(end - 1) == 0.0) --end;
-  return std::vector<double>(params.begin() + offset, end);
-}
-
-}  // namespace
 
 void to_json(nlohmann::json& j, const Camera& camera) {
   const auto& p = camera.params();

@@ -28,6 +28,10 @@ class Camera {
   static Camera Ocam(int width, int height, double cx, double cy, double c, double d, double e,
                      const std::vector<double>& direct, const std::vector<double>& inverse);
 
+  // The same lens for its images resized to width × height, as cv::resize maps pixels (centres
+  // scale about the image's corner: u' = (u + 0.5)·width'/width − 0.5). Throws Error on a size ≤ 0.
+  Camera Resized(int width, int height) const;
+
   CameraModelId model() const { return model_; }
   std::string model_name() const;
   int width() const { return width_; }

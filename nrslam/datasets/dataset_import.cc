@@ -1,6 +1,7 @@
 #include "nrslam/datasets/dataset_import.h"
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
@@ -261,8 +262,19 @@ FrameSource Images(const ImportOptions& options) {
   return source;
 }
 
-// Every frame of `source` up to `count`, and its poses, into `writer`.
-void WriteFrames(const ImportOptions& options, const FrameSource& source, int count, const SequenceWriter& writer) {
+// An image as written: at `size` (area-averaged down, bilinear up; a depth map by nearest pixel).
+cv::Mat Resized(const cv::Mat& image, const cv::Size& size, bool depth) {
+  if (image.size() == size) return image;
+  cv::Mat resized;
+  const int interpolation = depth ? cv::INTER_NEAREST : size.width < image.cols ? cv::INTER_AREA : cv::INTER_LINEAR;
+  cv::resize(image, resized, size, 0, 0, interpolation);
+  return resized;
+}
+
+// Every frame of `source` up to `count`, and its poses, into `writer`, the images resized to
+// `written` (the size of the written sequence's camera).
+void WriteFrames(const ImportOptions& options, const FrameSource& source, int count, const cv::Size& written,
+                 const SequenceWriter& writer) {
   const cv::Size size(source.camera.width(), source.camera.height());
   for (int i = 0; i < count; ++i) {
     const cv::Mat rgb = source.rgb(i);
@@ -270,12 +282,12 @@ void WriteFrames(const ImportOptions& options, const FrameSource& source, int co
       Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
                         " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
     }
-    writer.WriteRgb(i, rgb);
-    if (source.right) writer.WriteRight(i, source.right(i));
+    writer.WriteRgb(i, Resized(rgb, written, false));
+    if (source.right) writer.WriteRight(i, Resized(source.right(i), written, false));
     if (source.depth_mm) {
       const cv::Mat depth = source.depth_mm(i);
       if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(i) + " has another size than the image");
-      writer.WriteDepthMm(i, depth);
+      writer.WriteDepthMm(i, Resized(depth, written, true));
     }
   }
   if (!source.world_from_camera.empty()) {
@@ -298,6 +310,7 @@ void ImportOptions::Check() const {
   if (!(fps > 0) || max_frames < 0 || !(depth_unit_mm > 0) || !(near > 0) || !(far > near) || !(scene_unit_mm > 0)) {
     throw Error("import options: need fps > 0, max_frames >= 0, depth_unit_mm > 0, 0 < near < far, scene_unit_mm > 0");
   }
+  if (!(scale > 0 && scale <= 4)) throw Error("import options: scale must be in (0, 4], got " + std::to_string(scale));
 }
 
 std::vector<std::string> ImportFormats() { return {"endomapper-sim", "hamlyn", "c3vd", "images"}; }
@@ -312,17 +325,24 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
                                                           : Images(options);
   const int count = options.max_frames > 0 ? std::min(options.max_frames, source.count) : source.count;
   SequenceInfo info;
-  info.camera = source.camera;
+  info.camera = options.scale == 1.0
+                    ? source.camera
+                    : source.camera.Resized(std::max(1, static_cast<int>(std::lround(source.camera.width() * options.scale))),
+                                            std::max(1, static_cast<int>(std::lround(source.camera.height() * options.scale))));
   info.fps = options.fps;
   info.frame_count = count;
   info.depth_unit_mm = options.depth_unit_mm;
-  if (source.right) info.stereo = StereoInfo{source.baseline_mm, source.camera};
+  if (source.right) info.stereo = StereoInfo{source.baseline_mm, info.camera};
   info.provenance = {{"generator", std::string("nrslam_import ") + NRSLAM_VERSION},
                      {"format", options.format},
                      {"source", fs::absolute(options.input).string()}};
+  if (options.scale != 1.0) {
+    info.provenance["scale"] = options.scale;
+    info.provenance["source_camera"] = source.camera;
+  }
   const SequenceWriter writer(out, info, static_cast<bool>(source.depth_mm));
   try {
-    WriteFrames(options, source, count, writer);
+    WriteFrames(options, source, count, cv::Size(info.camera.width(), info.camera.height()), writer);
   } catch (...) {
     // Half a sequence would pass for a whole one until its missing frames are read: a failed
     // import leaves none.

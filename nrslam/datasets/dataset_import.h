@@ -32,6 +32,11 @@ struct ImportOptions {
   double fps = 30.0;                   // frames per second (timestamps of the ground truth)
   int max_frames = 0;                  // import at most this many frames; 0 = all
   double depth_unit_mm = 0.01;         // resolution of the written 16-bit depth, mm
+  // Resize factor for every image, depth map and the calibration (which describes the dataset's
+  // own images), in (0, 4]: 0.5 halves Endomapper's 1440×1080 to 720×540, as the reference does.
+  // Colour is area-averaged down (bilinear up); depth takes the nearest pixel, so no written depth
+  // blends two surfaces across an edge.
+  double scale = 1.0;
   double near = 0.01, far = 4.0;       // endomapper-sim: depth-buffer planes, scene units
   double scene_unit_mm = 1000.0;       // endomapper-sim: mm per scene unit (Unity: metres)
   void Check() const;
