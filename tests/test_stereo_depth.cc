@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <iterator>
 
 #include "nrslam/datasets/stereo_depth.h"
@@ -95,6 +97,21 @@ TEST(StereoDepth, ToolWritesTheSequencesDepth) {
   EXPECT_EQ(ReadJsonFile(folder / "seq" / "sequence.json")["provenance"]["depth"]["frames_without_input"],
             nlohmann::json::array({1}));
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder / "seq"), {}), 5);  // no staging folder left
+  // A distorted lens is refused, not matched as if rectified: its disparities are not depth.
+  {
+    nlohmann::json description = ReadJsonFile(folder / "seq" / "sequence.json");
+    for (nlohmann::json* camera : {&description["camera"], &description["stereo"]["right_camera"]}) {
+      (*camera)["model"] = "opencv";
+      (*camera)["distortion"] = {-0.02, 0.0, 0.0, 0.0, 0.0};
+    }
+    std::ofstream(folder / "seq" / "sequence.json") << description.dump(2);
+  }
+  EXPECT_NE(std::system((tools + "/nrslam_stereo_gt --quiet --overwrite " + (folder / "seq").string() + " > " +
+                         (folder / "distorted.log").string() + " 2>&1").c_str()),
+            0);
+  std::ostringstream log;
+  log << std::ifstream(folder / "distorted.log").rdbuf();
+  EXPECT_NE(log.str().find("needs a rectified pair with a pinhole camera"), std::string::npos) << log.str();
   // A mono sequence is refused with a message, not a crash.
   ASSERT_EQ(std::system((tools + "/nrslam_simulate --preset sim-0 --frames 2 --width 160 --height 120 --quiet --out " +
                          (folder / "mono").string() + " > /dev/null").c_str()),

@@ -35,6 +35,12 @@ int main(int argc, char** argv) {
     if (!sequence.has_right() || !sequence.info().stereo) {
       throw nrslam::Error(folder + " has no right images and stereo baseline (sequence.json \"stereo\")");
     }
+    // Disparity is depth only along the rows of a rectified pinhole pair; a lens with distortion
+    // would give depth that looks right and is not.
+    if (sequence.info().camera.model() != nrslam::CameraModelId::kPinhole) {
+      throw nrslam::Error(folder + ": stereo depth needs a rectified pair with a pinhole camera, and this sequence's is " +
+                          sequence.info().camera.model_name() + " (rectify the pair first, e.g. cv::stereoRectify)");
+    }
     if (sequence.has_depth() && !overwrite) throw nrslam::Error(folder + " already has depth/ (use --overwrite)");
     nrslam::SequenceInfo info = sequence.info();
     info.provenance["depth"] = {{"generator", std::string("nrslam_stereo_gt ") + NRSLAM_VERSION},
