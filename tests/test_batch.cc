@@ -128,9 +128,10 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
     "defaults": {"set": {"k": 2, "max_degree_D": 4}, "simulate": {"frames": 9}},
     "sequences": [
       {"name": "s", "preset": "sim-1", "set": {"max_degree_D": 6}},
-      {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3, "camera": "cams/f.json"}
+      {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3, "camera": "cams/f.json"},
+      {"name": "l", "preset": "sim-1", "simulate": {"camera.calibration": "lenses/l.yml"}}
     ]})"));
-  ASSERT_EQ(manifest.sequences.size(), 2u);
+  ASSERT_EQ(manifest.sequences.size(), 3u);
   const ManifestSequence& s = manifest.sequences[0];
   EXPECT_EQ(s.simulate, std::vector<std::string>{"frames=9"});
   EXPECT_EQ(s.assignments, (std::vector<std::string>{"deformation.k=2", "deformation.max_degree_D=6"}));
@@ -141,6 +142,10 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   EXPECT_NE(std::find(f.assignments.begin(), f.assignments.end(), "run.first_frame=3"), f.assignments.end());
   const std::string camera = "run.camera=" + (std::filesystem::absolute(folder) / "lists" / "cams" / "f.json").lexically_normal().string();
   EXPECT_NE(std::find(f.assignments.begin(), f.assignments.end(), camera), f.assignments.end());
+  // A lens to render with is a path too, relative to the manifest.
+  const std::string lens =
+      "camera.calibration=" + (std::filesystem::absolute(folder) / "lists" / "lenses" / "l.yml").lexically_normal().string();
+  EXPECT_EQ(manifest.sequences[2].simulate, (std::vector<std::string>{lens, "frames=9"}));
   std::filesystem::remove_all(folder);
 }
 

@@ -122,7 +122,12 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
     }
     if (entry.contains("simulate")) {
       Require(entry["simulate"].is_object(), context, "\"simulate\" must be an object of simulator options");
-      for (const auto& [key, value] : entry["simulate"].items()) sequence.simulate.push_back(Assignment(key, value));
+      for (const auto& [key, value] : entry["simulate"].items()) {
+        // A lens file to render with is, like every path in a manifest, relative to its folder.
+        const bool lens_file = (key == "camera.calibration" || key == "calibration") && value.is_string() &&
+                               !value.get<std::string>().empty();
+        sequence.simulate.push_back(Assignment(key, lens_file ? Json(FromManifest(value, folder).string()) : value));
+      }
       std::sort(sequence.simulate.begin(), sequence.simulate.end());
       try {
         WithAssignments(sim, sequence.simulate);
