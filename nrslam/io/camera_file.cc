@@ -131,8 +131,8 @@ Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
   const double fx = k[0], fy = k[4], cx = k[2], cy = k[5];
   if (fisheye) {
     if (distortion.size() != 4) {
-      throw Error("the fisheye (equidistant) model needs 4 coefficients in '" + distortion_key + "', got " +
-                  std::to_string(distortion.size()));
+      throw Error("the fisheye (equidistant) model needs 4 distortion coefficients, got " +
+                  std::to_string(distortion.size()) + (distortion_key.empty() ? "" : " in '" + distortion_key + "'"));
     }
     return Camera::KannalaBrandt(width, height, fx, fy, cx, cy,
                                  Eigen::Vector4d(distortion[0], distortion[1], distortion[2], distortion[3]));
