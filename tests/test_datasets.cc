@@ -146,8 +146,13 @@ TEST(DatasetImport, ScaleResizesImagesDepthAndCalibrationTogether) {
     depth.colRange(kWidth / 2 + 1, kWidth).setTo(90);  // a step edge between two columns pairs average over
     return depth;
   });
+  // An endoscope's black border, given as the images' fixed mask, is resized with them.
+  cv::Mat border(kHeight, kWidth, CV_8UC1, cv::Scalar(0));
+  border(cv::Rect(8, 6, kWidth - 16, kHeight - 12)).setTo(255);
+  cv::imwrite((in / "border.png").string(), border);
   ImportOptions options = Options("hamlyn", in);
   options.scale = 0.5;
+  options.mask = in / "border.png";
   ImportDataset(options, out);
   const SequenceReader sequence(out);
   const Camera expected = Camera::Pinhole(kWidth, kHeight, 50.5, 50.7, 31.2, 23.9).Resized(kWidth / 2, kHeight / 2);
@@ -165,6 +170,16 @@ TEST(DatasetImport, ScaleResizesImagesDepthAndCalibrationTogether) {
     EXPECT_TRUE(value == 60.f || value == 90.f) << "column " << x << " reads " << value;
   }
   EXPECT_EQ(sequence.info().provenance.at("scale"), 0.5);
+  const cv::Mat mask = sequence.ReadMask(0);
+  ASSERT_EQ(mask.size(), cv::Size(kWidth / 2, kHeight / 2));
+  EXPECT_EQ(mask.at<uint8_t>(1, 1), 0);
+  EXPECT_EQ(mask.at<uint8_t>(kHeight / 4, kWidth / 4), 255);
+  EXPECT_EQ(cv::countNonZero(mask), (kWidth - 16) / 2 * (kHeight - 12) / 2);
+
+  cv::imwrite((in / "border.png").string(), cv::Mat(kHeight / 2, kWidth, CV_8UC1, cv::Scalar(255)));
+  EXPECT_NE(ImportError(options, UniqueTempFolder("scaled_out_2")).find("is 64x24 but the images are 64x48"),
+            std::string::npos);
+  options.mask.clear();
 
   options.scale = 0;
   EXPECT_NE(ImportError(options, UniqueTempFolder("scaled_out_2")).find("scale must be in (0, 4]"), std::string::npos);

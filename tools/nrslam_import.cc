@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   app.add_option("--in", options.input, "the dataset's folder (or a video file for --format images)")->required();
   app.add_option("--out", out, "sequence folder to write")->required();
   app.add_option("--calibration", options.calibration, "camera JSON (as in sequence.json), OCamCalib's calib_results.txt or an OpenCV / ROS calibration (.yml, .yaml, .xml); c3vd and images need one");
+  app.add_option("--mask", options.mask,
+                 "fixed validity mask of the images (non-zero = usable), e.g. the black border of an endoscope's image");
   app.add_option("--fps", options.fps, "frames per second")->capture_default_str();
   app.add_option("--max-frames", options.max_frames, "import at most this many frames (0 = all)")->capture_default_str();
   app.add_option("--depth-unit-mm", options.depth_unit_mm, "resolution of the written depth, mm")->capture_default_str();

@@ -38,6 +38,8 @@ struct FrameSource {
 }
 
 cv::Mat ReadImage(const ImportOptions& options, const fs::path& file, int flags) {
+  // Checked first: OpenCV would print a warning of its own before our message.
+  if (!fs::is_regular_file(file)) Fail(options, file.string() + " does not exist");
   cv::Mat image = cv::imread(file.string(), flags);
   if (image.empty()) Fail(options, "cannot read " + file.string() + " (missing or corrupt)");
   return image;
@@ -340,8 +342,21 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
     info.provenance["scale"] = options.scale;
     info.provenance["source_camera"] = source.camera;
   }
+  cv::Mat mask;
+  if (!options.mask.empty()) {
+    mask = ReadImage(options, options.mask, cv::IMREAD_GRAYSCALE);
+    if (mask.cols != source.camera.width() || mask.rows != source.camera.height()) {
+      Fail(options, "the mask " + options.mask.string() + " is " + std::to_string(mask.cols) + "x" +
+                        std::to_string(mask.rows) + " but the images are " + std::to_string(source.camera.width()) +
+                        "x" + std::to_string(source.camera.height()));
+    }
+    mask = Resized(mask, cv::Size(info.camera.width(), info.camera.height()), true) > 0;
+    if (cv::countNonZero(mask) == 0) Fail(options, "the mask " + options.mask.string() + " leaves no pixel usable");
+    info.mask = "mask.png";
+  }
   const SequenceWriter writer(out, info, static_cast<bool>(source.depth_mm));
   try {
+    if (!mask.empty()) writer.WriteFixedMask(mask);
     WriteFrames(options, source, count, cv::Size(info.camera.width(), info.camera.height()), writer);
   } catch (...) {
     // Half a sequence would pass for a whole one until its missing frames are read: a failed

@@ -29,6 +29,10 @@ struct ImportOptions {
   std::string format;                  // endomapper-sim, hamlyn, c3vd, images
   std::filesystem::path input;         // the dataset's folder (or video file for "images")
   std::filesystem::path calibration;   // camera JSON; required for c3vd and images
+  // A fixed validity mask of the dataset's images (non-zero = usable; e.g. the black border of an
+  // endoscope's image, whose edge would otherwise be tracked as corners that never move), written
+  // as the sequence's mask.png; empty = none.
+  std::filesystem::path mask;
   double fps = 30.0;                   // frames per second (timestamps of the ground truth)
   int max_frames = 0;                  // import at most this many frames; 0 = all
   double depth_unit_mm = 0.01;         // resolution of the written 16-bit depth, mm
