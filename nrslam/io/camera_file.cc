@@ -69,6 +69,13 @@ std::string Lowercase(std::string text) {
   return text;
 }
 
+std::string FileText(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
 bool IsOpenCvCalibration(const std::filesystem::path& file, char first) {
   const std::string extension = Lowercase(file.extension().string());
   return first == '%' || first == '<' || extension == ".yml" || extension == ".yaml" || extension == ".xml";
@@ -77,10 +84,7 @@ bool IsOpenCvCalibration(const std::filesystem::path& file, char first) {
 }  // namespace
 
 Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  std::string contents = text.str();
+  std::string contents = FileText(file);
   // OpenCV's YAML reader wants the version directive its writer puts first; ROS leaves it out.
   const size_t first = contents.find_first_not_of(" \t\r\n");
   if (first != std::string::npos && contents[first] != '%' && contents[first] != '<') {
@@ -182,10 +186,7 @@ Camera ReadCameraFile(const std::filesystem::path& file) {
     }
     if (first != 0 && first != '{') {
       // Not a JSON object: OCamCalib's text format.
-      std::ifstream stream(file);
-      std::ostringstream text;
-      text << stream.rdbuf();
-      return ParseOcamCalibResults(text.str());
+      return ParseOcamCalibResults(FileText(file));
     }
     const Json json = ReadJsonFile(file);
     // A sequence.json holds the camera under "camera"; taking it saves users cutting it out.
