@@ -119,6 +119,12 @@ TEST(Manifest, EachMistakeIsNamed) {
             std::string::npos);
   EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "preset": "sim-0", "set": {"k": -1}})")).find("sequence 1 ('a')"),
             std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "import": {"format": "stereo", "path": "x", "scale": true}})"))
+                .find("\"scale\" takes a value, not true or false"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest(R"({"name": "a", "import": {"format": "stereo", "path": "x", "stereo_depth": "yes"}})"))
+                .find("\"stereo_depth\" must be true or false"),
+            std::string::npos);
   std::filesystem::remove_all(folder);
 }
 
@@ -129,9 +135,11 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
     "sequences": [
       {"name": "s", "preset": "sim-1", "set": {"max_degree_D": 6}},
       {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3, "camera": "cams/f.json"},
-      {"name": "l", "preset": "sim-1", "simulate": {"camera.calibration": "lenses/l.yml"}}
+      {"name": "l", "preset": "sim-1", "simulate": {"camera.calibration": "lenses/l.yml"}},
+      {"name": "st", "import": {"format": "stereo", "path": "raw/left.avi", "right": "raw/right.avi",
+                                "calibration": "raw/stereo.yml", "rectified_size": "720x576", "stereo_depth": true}}
     ]})"));
-  ASSERT_EQ(manifest.sequences.size(), 3u);
+  ASSERT_EQ(manifest.sequences.size(), 4u);
   const ManifestSequence& s = manifest.sequences[0];
   EXPECT_EQ(s.simulate, std::vector<std::string>{"frames=9"});
   EXPECT_EQ(s.assignments, (std::vector<std::string>{"deformation.k=2", "deformation.max_degree_D=6"}));
@@ -146,6 +154,12 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   const std::string lens =
       "camera.calibration=" + (std::filesystem::absolute(folder) / "lists" / "lenses" / "l.yml").lexically_normal().string();
   EXPECT_EQ(manifest.sequences[2].simulate, (std::vector<std::string>{lens, "frames=9"}));
+  // A raw stereo recording: its three files relative to the manifest, a flag given bare (the
+  // options in the keys' alphabetical order).
+  const auto raw = [&](const char* file) { return (std::filesystem::absolute(folder) / "lists" / "raw" / file).lexically_normal().string(); };
+  EXPECT_EQ(manifest.sequences[3].import,
+            (std::vector<std::string>{"--calibration", raw("stereo.yml"), "--format", "stereo", "--in", raw("left.avi"),
+                                      "--rectified-size", "720x576", "--right", raw("right.avi"), "--stereo-depth"}));
   std::filesystem::remove_all(folder);
 }
 

@@ -16,6 +16,7 @@
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
 #include "camera_fixtures.h"
+#include "error_message.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -36,12 +37,7 @@ void WriteCalibration(const fs::path& file) {
 }
 
 std::string ImportError(const ImportOptions& options, const fs::path& out) {
-  try {
-    ImportDataset(options, out);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return ErrorMessage([&] { ImportDataset(options, out); });
 }
 
 ImportOptions Options(const std::string& format, const fs::path& input) {
@@ -130,6 +126,20 @@ TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
   EXPECT_DOUBLE_EQ(sequence.info().stereo->baseline_mm, 5.38);
   EXPECT_FLOAT_EQ(sequence.ReadDepthMm(2).at<float>(5, 5), 62.f);
   EXPECT_FALSE(sequence.has_groundtruth());
+
+  // --stereo-depth: for a Hamlyn sequence without depth01/, depth from its rectified pairs.
+  options.stereo_depth = true;
+  EXPECT_NE(ImportError(options, UniqueTempFolder("hamlyn_stereo")).find("has depth of its own"), std::string::npos);
+  fs::remove_all(in / "depth01");
+  ImportDataset(options, UniqueTempFolder("hamlyn_stereo"));
+  const SequenceReader stereo(UniqueTempFolder("hamlyn_stereo"));
+  EXPECT_TRUE(stereo.has_depth());
+  EXPECT_EQ(stereo.info().provenance.at("depth").at("generator").get<std::string>().rfind("nrslam_import --stereo-depth", 0), 0u);
+  fs::remove_all(UniqueTempFolder("hamlyn_stereo"));
+  fs::remove_all(in / "image02");
+  EXPECT_NE(ImportError(options, out).find("--stereo-depth needs the right camera's images"), std::string::npos);
+  HamlynFixture(in, [](int i) { return cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)); });
+  options.stereo_depth = false;
 
   fs::remove(in / "image02" / "0000000001.png");
   EXPECT_NE(ImportError(options, out).find("image02/ has 2 images, image01/ 3"), std::string::npos);

@@ -23,7 +23,9 @@ const std::set<std::string> kExternalKeys = {"estimates", "trajectory", "stride"
 
 // The keys of an "import" object: nrslam_import's options by their long names.
 const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
-                                           "depth_unit_mm", "near", "far", "scene_unit_mm", "scale", "mask"};
+                                           "depth_unit_mm", "near", "far", "scene_unit_mm", "scale", "mask",
+                                           "right", "stereo_layout", "extrinsics", "stereo_unit_mm",
+                                           "rectified_size", "rectify_alpha", "stereo_depth"};
 
 void Require(bool condition, const std::string& context, const std::string& message) {
   if (!condition) throw Error(context + ": " + message);
@@ -98,9 +100,15 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
     for (const auto& [key, value] : import.items()) {
       Require(kImportKeys.count(key) > 0, context, "import: unknown key '" + key + "'");
       std::string text = value.is_string() ? value.get<std::string>() : value.dump();
-      if (key == "path" || key == "calibration" || key == "mask") text = FromManifest(text, folder).string();
+      if (key == "path" || key == "calibration" || key == "mask" || key == "right" || key == "extrinsics") text = FromManifest(text, folder).string();
       std::string option = key == "path" ? "in" : key;
       std::replace(option.begin(), option.end(), '_', '-');
+      Require(value.is_boolean() == (key == "stereo_depth"), context,
+              "import: \"" + key + (key == "stereo_depth" ? "\" must be true or false" : "\" takes a value, not true or false"));
+      if (value.is_boolean()) {  // a flag: given when true
+        if (value.get<bool>()) sequence.import.push_back("--" + option);
+        continue;
+      }
       sequence.import.push_back("--" + option);
       sequence.import.push_back(text);
     }

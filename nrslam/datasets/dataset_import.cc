@@ -10,9 +10,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <sstream>
 
+#include "nrslam/datasets/stereo_depth.h"
+#include "nrslam/datasets/stereo_rectification.h"
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
@@ -31,6 +34,7 @@ struct FrameSource {
   std::function<cv::Mat(int)> right;     // empty when no right camera
   double baseline_mm = 0.0;
   std::vector<Rigid3> world_from_camera;  // per frame, or empty
+  nlohmann::json provenance = nlohmann::json::object();  // what the importer did beyond reading
 };
 
 [[noreturn]] void Fail(const ImportOptions& options, const std::string& message) {
@@ -239,28 +243,130 @@ FrameSource C3vd(const ImportOptions& options) {
   return source;
 }
 
+// The frames of an image folder (sorted by name) or a video file: their count and a reader,
+// which reads a video's frames in order.
+struct FrameStream {
+  int count = 0;
+  std::function<cv::Mat(int)> read;  // BGR
+};
+
+FrameStream OpenFrames(const ImportOptions& options, const fs::path& input) {
+  FrameStream stream;
+  if (fs::is_directory(input)) {
+    const std::vector<fs::path> files = ImageFiles(input);
+    if (files.empty()) Fail(options, "no image files in " + input.string());
+    stream.count = static_cast<int>(files.size());
+    stream.read = [&options, files](int i) { return ReadImage(options, files[i], cv::IMREAD_COLOR); };
+    return stream;
+  }
+  // A video: count the frames first (grab without decoding), then decode them in order.
+  if (!fs::exists(input)) Fail(options, input.string() + " does not exist");
+  cv::VideoCapture counter(input.string());
+  if (!counter.isOpened()) Fail(options, "cannot open " + input.string() + " as an image folder or a video");
+  while (counter.grab()) ++stream.count;
+  if (stream.count == 0) Fail(options, "the video " + input.string() + " has no frames");
+  auto video = std::make_shared<cv::VideoCapture>(input.string());
+  stream.read = [&options, video, input](int i) {
+    cv::Mat frame;
+    if (!video->read(frame)) Fail(options, "cannot decode frame " + std::to_string(i) + " of " + input.string());
+    return frame;
+  };
+  return stream;
+}
+
 FrameSource Images(const ImportOptions& options) {
   if (options.calibration.empty()) Fail(options, "needs --calibration (a camera JSON)");
   FrameSource source;
   source.camera = LoadCalibration(options);
-  if (fs::is_directory(options.input)) {
-    const std::vector<fs::path> files = ImageFiles(options.input);
-    if (files.empty()) Fail(options, "no image files in the folder");
-    source.count = static_cast<int>(files.size());
-    source.rgb = [&options, files](int i) { return ReadImage(options, files[i], cv::IMREAD_COLOR); };
-    return source;
+  const FrameStream frames = OpenFrames(options, options.input);
+  source.count = frames.count;
+  source.rgb = frames.read;
+  return source;
+}
+
+// A raw stereo recording: the left and right images as two streams, or one stream whose images
+// hold both (side by side, or the left above the right), rectified with the pair's calibration.
+FrameSource Stereo(const ImportOptions& options) {
+  if (options.calibration.empty()) {
+    Fail(options, "needs --calibration: the pair's OpenCV stereo calibration (M1, D1, M2, D2, R, T)");
   }
-  // A video: count the frames first (grab without decoding), then decode them in order.
-  cv::VideoCapture counter(options.input.string());
-  if (!counter.isOpened()) Fail(options, "cannot open it as an image folder or a video");
-  while (counter.grab()) ++source.count;
-  if (source.count == 0) Fail(options, "the video has no frames");
-  auto video = std::make_shared<cv::VideoCapture>(options.input.string());
-  source.rgb = [&options, video](int i) {
-    cv::Mat frame;
-    if (!video->read(frame)) Fail(options, "cannot decode video frame " + std::to_string(i));
-    return frame;
+  const bool packed = !options.stereo_layout.empty();
+  if (packed == !options.right.empty()) {
+    Fail(options, "needs either --right (the right camera's images) or --stereo-layout (both in one image)");
+  }
+  const FrameStream left = OpenFrames(options, options.input);
+  const FrameStream right = packed ? left : OpenFrames(options, options.right);
+  if (right.count != left.count) {
+    Fail(options, "the right camera has " + std::to_string(right.count) + " frames, the left " +
+                      std::to_string(left.count));
+  }
+  // One image holding both views splits in halves; the calibration is of one view.
+  const bool side_by_side = options.stereo_layout == "side-by-side";
+  const auto half = [&options, side_by_side](const cv::Mat& both, int index, int i) {
+    const int width = side_by_side ? both.cols / 2 : both.cols, height = side_by_side ? both.rows : both.rows / 2;
+    if ((side_by_side ? both.cols : both.rows) % 2 != 0) {
+      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(both.cols) + "x" + std::to_string(both.rows) +
+                        ", which does not split into two equal views");
+    }
+    const cv::Rect view = side_by_side ? cv::Rect(index * width, 0, width, height) : cv::Rect(0, index * height, width, height);
+    return both(view).clone();
   };
+  // The left stream's last decoded frame: a video decodes in order, and a packed frame holds
+  // the right view too.
+  auto decoded = std::make_shared<std::pair<int, cv::Mat>>(0, left.read(0));
+  const auto left_frame = [left, decoded](int i) -> const cv::Mat& {
+    if (decoded->first != i) *decoded = {i, left.read(i)};
+    return decoded->second;
+  };
+  const cv::Mat first = packed ? half(decoded->second, 0, 0) : decoded->second;
+  std::vector<fs::path> calibration_files = {options.calibration};
+  if (!options.extrinsics.empty()) calibration_files.push_back(options.extrinsics);
+  StereoCalibration calibration;
+  try {
+    calibration = ReadStereoCalibration(calibration_files, std::make_pair(first.cols, first.rows), options.stereo_unit_mm);
+  } catch (const Error& e) {
+    Fail(options, e.what());
+  }
+  if (first.cols != calibration.left.width() || first.rows != calibration.left.height()) {
+    Fail(options, "left frame 0 is " + std::to_string(first.cols) + "x" + std::to_string(first.rows) +
+                      " but the calibration is " + std::to_string(calibration.left.width()) + "x" +
+                      std::to_string(calibration.left.height()));
+  }
+  StereoRectificationOptions rectification;
+  rectification.width = options.rectified_width;
+  rectification.height = options.rectified_height;
+  rectification.alpha = options.rectify_alpha;
+  std::shared_ptr<const StereoRectifier> rectifier;
+  try {
+    rectifier = std::make_shared<const StereoRectifier>(calibration, rectification);
+  } catch (const Error& e) {
+    Fail(options, e.what());
+  }
+  FrameSource source;
+  source.count = left.count;
+  source.camera = rectifier->camera();
+  source.baseline_mm = rectifier->baseline_mm();
+  std::vector<std::string> files;
+  for (const fs::path& file : calibration_files) files.push_back(fs::absolute(file).string());
+  const Eigen::Matrix3d& r1 = rectifier->rectified_from_left();
+  source.provenance["rectification"] = {
+      {"calibration", files},
+      {"alpha", options.rectify_alpha},
+      {"raw_left_camera", calibration.left},
+      {"raw_right_camera", calibration.right},
+      {"rectified_from_raw_left", {{r1(0, 0), r1(0, 1), r1(0, 2)}, {r1(1, 0), r1(1, 1), r1(1, 2)}, {r1(2, 0), r1(2, 1), r1(2, 2)}}}};
+  const auto raw = [=, &options](bool right_view, int i) {
+    const cv::Mat image = packed ? half(left_frame(i), right_view ? 1 : 0, i) : right_view ? right.read(i) : left_frame(i);
+    if (image.cols != calibration.left.width() || image.rows != calibration.left.height()) {
+      Fail(options, std::string(right_view ? "right" : "left") + " frame " + std::to_string(i) + " is " +
+                        std::to_string(image.cols) + "x" + std::to_string(image.rows) + " but the " +
+                        (right_view ? "left frames and the " : "") + "calibration " + (right_view ? "are " : "is ") +
+                        std::to_string(calibration.left.width()) + "x" + std::to_string(calibration.left.height()));
+    }
+    return image;
+  };
+  source.rgb = [raw, rectifier](int i) { return rectifier->Left(raw(false, i)); };
+  source.right = [raw, rectifier](int i) { return rectifier->Right(raw(true, i)); };
   return source;
 }
 
@@ -285,9 +391,11 @@ void WriteFrames(const ImportOptions& options, const FrameSource& source, int co
                         " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
     }
     writer.WriteRgb(i, Resized(rgb, written, false));
-    if (source.right) writer.WriteRight(i, Resized(source.right(i), written, false));
-    if (source.depth_mm) {
-      const cv::Mat depth = source.depth_mm(i);
+    const cv::Mat right = source.right ? source.right(i) : cv::Mat();
+    if (!right.empty()) writer.WriteRight(i, Resized(right, written, false));
+    if (source.depth_mm || options.stereo_depth) {
+      const cv::Mat depth = source.depth_mm ? source.depth_mm(i)
+                                            : StereoDepthMm(rgb, right, source.camera.fx(), source.baseline_mm, StereoDepthOptions{});
       if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(i) + " has another size than the image");
       writer.WriteDepthMm(i, Resized(depth, written, true));
     }
@@ -313,9 +421,19 @@ void ImportOptions::Check() const {
     throw Error("import options: need fps > 0, max_frames >= 0, depth_unit_mm > 0, 0 < near < far, scene_unit_mm > 0");
   }
   if (!(scale > 0 && scale <= 4)) throw Error("import options: scale must be in (0, 4], got " + std::to_string(scale));
+  const bool stereo_option = !right.empty() || !extrinsics.empty() || !stereo_layout.empty() || rectified_width != 0 ||
+                             rectified_height != 0 || rectify_alpha != 0.0 || stereo_unit_mm != 1.0;
+  if (stereo_option && format != "stereo") {
+    throw Error("import options: the right images, stereo layout, extrinsics and rectification apply to --format stereo only");
+  }
+  if (!stereo_layout.empty() && stereo_layout != "side-by-side" && stereo_layout != "top-bottom") {
+    throw Error("import options: stereo layout must be side-by-side or top-bottom, got '" + stereo_layout + "'");
+  }
+  if (!(stereo_unit_mm > 0)) throw Error("import options: stereo_unit_mm must be > 0");
+  StereoRectificationOptions{rectified_width, rectified_height, rectify_alpha}.Check();
 }
 
-std::vector<std::string> ImportFormats() { return {"endomapper-sim", "hamlyn", "c3vd", "images"}; }
+std::vector<std::string> ImportFormats() { return {"endomapper-sim", "hamlyn", "c3vd", "images", "stereo"}; }
 
 SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
   options.Check();
@@ -324,6 +442,7 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
   FrameSource source = options.format == "endomapper-sim" ? EndomapperSim(options)
                        : options.format == "hamlyn"       ? Hamlyn(options)
                        : options.format == "c3vd"         ? C3vd(options)
+                       : options.format == "stereo"       ? Stereo(options)
                                                           : Images(options);
   const int count = options.max_frames > 0 ? std::min(options.max_frames, source.count) : source.count;
   SequenceInfo info;
@@ -338,6 +457,7 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
   info.provenance = {{"generator", std::string("nrslam_import ") + NRSLAM_VERSION},
                      {"format", options.format},
                      {"source", fs::absolute(options.input).string()}};
+  info.provenance.update(source.provenance);
   if (options.scale != 1.0) {
     info.provenance["scale"] = options.scale;
     info.provenance["source_camera"] = source.camera;
@@ -354,7 +474,13 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
     if (cv::countNonZero(mask) == 0) Fail(options, "the mask " + options.mask.string() + " leaves no pixel usable");
     info.mask = "mask.png";
   }
-  const SequenceWriter writer(out, info, static_cast<bool>(source.depth_mm));
+  if (options.stereo_depth) {
+    if (!source.right) Fail(options, "--stereo-depth needs the right camera's images");
+    if (source.depth_mm) Fail(options, "--stereo-depth: the dataset has depth of its own");
+    info.provenance["depth"] = {{"generator", std::string("nrslam_import --stereo-depth ") + NRSLAM_VERSION},
+                                {"options", nlohmann::json(StereoDepthOptions{})}};
+  }
+  const SequenceWriter writer(out, info, source.depth_mm || options.stereo_depth);
   try {
     if (!mask.empty()) writer.WriteFixedMask(mask);
     WriteFrames(options, source, count, cv::Size(info.camera.width(), info.camera.height()), writer);

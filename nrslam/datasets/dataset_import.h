@@ -12,6 +12,11 @@
 //                   is recognised from where the translation is). Calibration file required.
 //   images          a folder of images (sorted by name) or a video file, with a calibration
 //                   file; no ground truth (runs need monocular initialisation).
+//   stereo          a raw stereo recording: the left images (folder or video) and the right
+//                   ones, or one stream holding both views side by side or one above the other,
+//                   with the pair's OpenCV stereo calibration (io/camera_file.h); rectified
+//                   (datasets/stereo_rectification.h) into a pinhole pair with its baseline, so
+//                   nrslam_stereo_gt can give it depth. No ground truth.
 //
 // A calibration file is whatever io/camera_file.h reads: a JSON camera as in sequence.json,
 // OCamCalib's calib_results.txt or an OpenCV / ROS calibration (YAML or XML).
@@ -26,9 +31,9 @@
 namespace nrslam {
 
 struct ImportOptions {
-  std::string format;                  // endomapper-sim, hamlyn, c3vd, images
+  std::string format;                  // endomapper-sim, hamlyn, c3vd, images, stereo
   std::filesystem::path input;         // the dataset's folder (or video file for "images")
-  std::filesystem::path calibration;   // camera JSON; required for c3vd and images
+  std::filesystem::path calibration;   // camera JSON; required for c3vd and images; stereo's calibration for stereo
   // A fixed validity mask of the dataset's images (non-zero = usable; e.g. the black border of an
   // endoscope's image, whose edge would otherwise be tracked as corners that never move), written
   // as the sequence's mask.png; empty = none.
@@ -41,6 +46,22 @@ struct ImportOptions {
   // Colour is area-averaged down (bilinear up); depth takes the nearest pixel, so no written depth
   // blends two surfaces across an edge.
   double scale = 1.0;
+  // stereo: the right camera's images (folder or video), unless `stereo_layout` says the input's
+  // images hold both views: "side-by-side" (left half is the left camera) or "top-bottom" (top
+  // half is the left camera, as SCARED's videos).
+  std::filesystem::path right;
+  std::string stereo_layout;
+  // stereo: a second calibration file with the entries the first lacks (OpenCV's stereo_calib
+  // sample writes M1 D1 M2 D2 to intrinsics.yml and R T to extrinsics.yml); empty = none.
+  std::filesystem::path extrinsics;
+  double stereo_unit_mm = 1.0;  // stereo: mm per unit of the calibration's T (1000 when in metres)
+  // stereo: the rectified images' size, px (0 × 0 = automatic) and cv::stereoRectify's alpha
+  // (see StereoRectificationOptions).
+  int rectified_width = 0, rectified_height = 0;
+  double rectify_alpha = 0.0;
+  // Depth from the rectified pair (datasets/stereo_depth.h, default options), written as the
+  // sequence's depth as nrslam_stereo_gt would: for stereo recordings and Hamlyn without depth01/.
+  bool stereo_depth = false;
   double near = 0.01, far = 4.0;       // endomapper-sim: depth-buffer planes, scene units
   double scene_unit_mm = 1000.0;       // endomapper-sim: mm per scene unit (Unity: metres)
   void Check() const;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -81,11 +82,10 @@ bool IsOpenCvCalibration(const std::filesystem::path& file, char first) {
   return first == '%' || first == '<' || extension == ".yml" || extension == ".yaml" || extension == ".xml";
 }
 
-}  // namespace
-
-Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
+// The file opened by cv::FileStorage from its text. OpenCV's YAML reader wants the version
+// directive its writer puts first; ROS leaves it out, so it is added when missing.
+cv::FileStorage OpenCalibrationStorage(const std::filesystem::path& file) {
   std::string contents = FileText(file);
-  // OpenCV's YAML reader wants the version directive its writer puts first; ROS leaves it out.
   const size_t first = contents.find_first_not_of(" \t\r\n");
   if (first != std::string::npos && contents[first] != '%' && contents[first] != '<') {
     contents = "%YAML:1.0\n---\n" + contents;
@@ -97,30 +97,45 @@ Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
     throw Error("not a calibration OpenCV can read (YAML or XML): " + e.err);
   }
   if (!storage.isOpened()) throw Error("OpenCV cannot open it as a calibration (YAML or XML)");
-  const auto [matrix_key, matrix_node] = FirstEntry(storage, {"camera_matrix", "cameraMatrix", "K", "M1"});
-  if (matrix_key.empty()) throw Error("no camera matrix (camera_matrix, cameraMatrix, K or M1)");
+  return storage;
+}
+
+std::string KeyList(std::initializer_list<const char*> keys) {
+  std::string list;
+  for (const char* key : keys) list += std::string(list.empty() ? "" : ", ") + key;
+  return list;
+}
+
+// The image size the file states (image_width and image_height, or image_size / imageSize as
+// [width, height]); `fallback` when it states none and the caller knows it, else Error.
+std::pair<int, int> CalibrationImageSize(const cv::FileStorage& storage, std::optional<std::pair<int, int>> fallback) {
+  const auto [size_key, size_node] = FirstEntry(storage, {"image_size", "imageSize"});
+  if (!storage["image_width"].empty() && !storage["image_height"].empty()) {
+    return {static_cast<int>(storage["image_width"]), static_cast<int>(storage["image_height"])};
+  }
+  if (!size_key.empty()) {
+    const std::vector<double> size = EntryNumbers(size_node, size_key);
+    if (size.size() != 2) throw Error("'" + size_key + "' must be [width, height]");
+    return {static_cast<int>(size[0]), static_cast<int>(size[1])};
+  }
+  if (fallback) return *fallback;
+  throw Error("no image size (image_width and image_height, or image_size): add the size the calibration was made at");
+}
+
+// One camera of the file: its matrix under the first of `matrix_keys` it has, its distortion
+// under the first of `distortion_keys` (none = pinhole), its model from distortion_model.
+Camera ReadOpenCvCamera(const cv::FileStorage& storage, std::initializer_list<const char*> matrix_keys,
+                        std::initializer_list<const char*> distortion_keys, std::pair<int, int> size) {
+  const auto [matrix_key, matrix_node] = FirstEntry(storage, matrix_keys);
+  if (matrix_key.empty()) throw Error("no camera matrix (" + KeyList(matrix_keys) + ")");
   const std::vector<double> k = EntryNumbers(matrix_node, matrix_key);
   if (k.size() != 9) throw Error("'" + matrix_key + "' must be 3x3, has " + std::to_string(k.size()) + " numbers");
   if (k[1] != 0.0 || k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0) {
     throw Error("'" + matrix_key + "' must be [fx 0 cx; 0 fy cy; 0 0 1] (no skew)");
   }
+  const auto [width, height] = size;
 
-  int width = 0, height = 0;
-  const auto [size_key, size_node] = FirstEntry(storage, {"image_size", "imageSize"});
-  if (!storage["image_width"].empty() && !storage["image_height"].empty()) {
-    width = static_cast<int>(storage["image_width"]);
-    height = static_cast<int>(storage["image_height"]);
-  } else if (!size_key.empty()) {
-    const std::vector<double> size = EntryNumbers(size_node, size_key);
-    if (size.size() != 2) throw Error("'" + size_key + "' must be [width, height]");
-    width = static_cast<int>(size[0]);
-    height = static_cast<int>(size[1]);
-  } else {
-    throw Error("no image size (image_width and image_height, or image_size): add the size the calibration was made at");
-  }
-
-  const auto [distortion_key, distortion_node] =
-      FirstEntry(storage, {"distortion_coefficients", "dist_coeffs", "distCoeffs", "D", "D1"});
+  const auto [distortion_key, distortion_node] = FirstEntry(storage, distortion_keys);
   std::vector<double> distortion =
       distortion_key.empty() ? std::vector<double>() : EntryNumbers(distortion_node, distortion_key);
   const cv::FileNode model_node = storage["distortion_model"];
@@ -147,6 +162,53 @@ Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
   }
   if (undistorted) return Camera::Pinhole(width, height, fx, fy, cx, cy);
   return Camera::OpenCv(width, height, fx, fy, cx, cy, distortion);
+}
+
+}  // namespace
+
+Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
+  const cv::FileStorage storage = OpenCalibrationStorage(file);
+  return ReadOpenCvCamera(storage, {"camera_matrix", "cameraMatrix", "K", "M1"},
+                          {"distortion_coefficients", "dist_coeffs", "distCoeffs", "D", "D1"},
+                          CalibrationImageSize(storage, std::nullopt));
+}
+
+StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>& files,
+                                        std::optional<std::pair<int, int>> image_size, double translation_unit_mm) {
+  std::string names;
+  for (const std::filesystem::path& file : files) names += (names.empty() ? "" : ", ") + file.string();
+  try {
+    if (files.empty()) throw Error("no file given");
+    if (!(translation_unit_mm > 0)) throw Error("the unit of T must be > 0 mm");
+    std::vector<cv::FileStorage> storages;
+    for (const std::filesystem::path& file : files) storages.push_back(OpenCalibrationStorage(file));
+    // Each entry comes from the first file that has it: OpenCV's stereo_calib sample writes the
+    // intrinsics (M1 D1 M2 D2) and the extrinsics (R T) to two files.
+    const auto holding = [&](const char* key) -> const cv::FileStorage& {
+      for (const cv::FileStorage& storage : storages) {
+        if (!FirstEntry(storage, {key}).first.empty()) return storage;
+      }
+      throw Error(std::string("no '") + key + "'");
+    };
+    const std::pair<int, int> size = CalibrationImageSize(holding("M1"), image_size);
+    StereoCalibration stereo;
+    stereo.left = ReadOpenCvCamera(holding("M1"), {"M1"}, {"D1"}, size);
+    stereo.right = ReadOpenCvCamera(holding("M2"), {"M2"}, {"D2"}, size);
+    const std::vector<double> r = EntryNumbers(holding("R")["R"], "R");
+    const std::vector<double> t = EntryNumbers(holding("T")["T"], "T");
+    if (r.size() != 9) throw Error("'R' must be a 3x3 rotation, has " + std::to_string(r.size()) + " numbers");
+    if (t.size() != 3) throw Error("'T' must be 3 numbers, has " + std::to_string(t.size()));
+    const Eigen::Matrix3d rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
+    if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3 || rotation.determinant() < 0) {
+      throw Error("'R' is not a rotation");
+    }
+    stereo.right_from_left = Rigid3(Eigen::Quaterniond(rotation), Eigen::Vector3d(t[0], t[1], t[2]) * translation_unit_mm);
+    stereo.left.Check();
+    stereo.right.Check();
+    return stereo;
+  } catch (const std::exception& e) {
+    throw Error("stereo calibration " + names + ": " + e.what());
+  }
 }
 
 Camera ParseOcamCalibResults(const std::string& text) {

@@ -2,13 +2,17 @@
 // (model, width, height, cx, cy, and fx, fy, k, distortion or the ocam fields), a whole
 // sequence.json, whose "camera" is then read, OCamCalib's calib_results.txt (the Scaramuzza
 // model, `ocam`), or an OpenCV calibration file (cv::FileStorage YAML or XML, as OpenCV's
-// calibration tools and ROS's camera_info write them).
+// calibration tools and ROS's camera_info write them); and a stereo pair's OpenCV calibration.
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "nrslam/camera/camera.h"
+#include "nrslam/geometry/rigid3.h"
 
 namespace nrslam {
 
@@ -33,5 +37,21 @@ Camera ParseOcamCalibResults(const std::string& text);
 //    model; 4 are ambiguous between the two and refused.
 // Throws Error naming what is missing or wrong.
 Camera ReadOpenCvCalibration(const std::filesystem::path& file);
+
+// A calibrated stereo pair, as cv::stereoCalibrate gives it: each camera's own lens and where the
+// second camera is, x_right = R·x_left + T.
+struct StereoCalibration {
+  Camera left, right;
+  Rigid3 right_from_left;  // translation in mm
+};
+
+// A stereo calibration in OpenCV's names (cv::FileStorage YAML or XML): M1, D1, M2, D2, R and T,
+// as OpenCV's stereo_calib sample and the SCARED dataset write them. Each entry is taken from the
+// first of `files` that has it (the sample writes intrinsics.yml and extrinsics.yml). The image
+// size is the file's (as ReadOpenCvCalibration reads it) or else `image_size` (width, height); T
+// is in units of `translation_unit_mm` (1 when in mm, 1000 when in metres). Both cameras share
+// one distortion_model. Throws Error naming the files and what is missing or wrong.
+StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>& files,
+                                        std::optional<std::pair<int, int>> image_size, double translation_unit_mm);
 
 }  // namespace nrslam
