@@ -4,12 +4,15 @@
 // and a video give the same images; calibrations that cannot give a side-by-side pair are refused.
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
+#include <iomanip>
+#include <sstream>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -157,7 +160,7 @@ ImportOptions StereoImport(const fs::path& in) {
   options.input = in / "left";
   options.right = in / "right";
   options.calibration = in / "intrinsics.yml";
-  options.extrinsics = in / "extrinsics.yml";
+  options.second_calibration = in / "extrinsics.yml";
   return options;
 }
 
@@ -272,6 +275,85 @@ TEST(StereoRectification, InterlacedFieldsAreStretchedToSquarePixels) {
   EXPECT_EQ(chosen.camera().height(), 515);
 }
 
+// A matrix as a YAML flow list, row by row, with every digit a double keeps.
+std::string FlowList(const Eigen::MatrixXd& matrix) {
+  std::ostringstream text;
+  text << std::setprecision(17) << "[";
+  for (int r = 0; r < matrix.rows(); ++r) {
+    for (int c = 0; c < matrix.cols(); ++c) text << (r + c > 0 ? ", " : "") << matrix(r, c);
+  }
+  text << "]";
+  return text.str();
+}
+
+void ExpectSameRig(const StereoCalibration& read, const StereoCalibration& rig) {
+  EXPECT_EQ(read.left.params(), rig.left.params());
+  EXPECT_EQ(read.right.params(), rig.right.params());
+  EXPECT_EQ(read.left.width(), rig.left.width());
+  EXPECT_EQ(read.right.height(), rig.right.height());
+  EXPECT_LT(read.right_from_left.rotation.angularDistance(rig.right_from_left.rotation), 1e-9);
+  EXPECT_LT((read.right_from_left.translation - rig.right_from_left.translation).norm(), 1e-9);  // mm
+}
+
+// Kalibr's camchain (metres, no %YAML line) and a ROS camera_info pair (ROS's own rectification,
+// its projection in metres) give the rig they describe.
+TEST(StereoRectification, KalibrAndRosCalibrationsGiveTheirRig) {
+  const fs::path folder = UniqueTempFolder("stereo_formats");
+  fs::create_directories(folder);
+  StereoCalibration rig = Rig();
+  rig.left = Camera::OpenCv(kWidth, kHeight, 300, 302, 161.0, 118.5, {-0.25, 0.08, 0.001, -0.0005});  // radtan: 4
+  const Eigen::Matrix4d cam1_from_cam0 = rig.right_from_left.Matrix();
+  const auto kalibr_camera = [](const Camera& camera) {
+    const std::vector<double>& p = camera.params();
+    return "  camera_model: pinhole\n  distortion_model: radtan\n  distortion_coeffs: " +
+           FlowList(Eigen::Vector4d(p[4], p[5], p[6], p[7]).transpose()) + "\n  intrinsics: " +
+           FlowList(Eigen::Vector4d(p[0], p[1], p[2], p[3]).transpose()) + "\n  resolution: [320, 240]\n  rostopic: /cam/image_raw\n";
+  };
+  {
+    // T_cn_cnm1 in metres, one row per line.
+    std::ofstream file(folder / "camchain.yaml");
+    file << "cam0:\n  cam_overlaps: [1]\n" << kalibr_camera(rig.left) << "cam1:\n  T_cn_cnm1:\n";
+    Eigen::Matrix4d metres = cam1_from_cam0;
+    metres.topRightCorner<3, 1>() /= 1000.0;
+    for (int r = 0; r < 4; ++r) file << "  - " << FlowList(metres.row(r)) << "\n";
+    file << "  cam_overlaps: [0]\n" << kalibr_camera(rig.right);
+  }
+  ExpectSameRig(ReadStereoCalibration({folder / "camchain.yaml"}, std::nullopt, 0.0), rig);
+
+  cv::Mat r1, r2, p1, p2, q;
+  const auto k = [](const Camera& c) { return cv::Matx33d(c.fx(), 0, c.cx(), 0, c.fy(), c.cy(), 0, 0, 1); };
+  const auto d = [](const Camera& c) { return cv::Mat(std::vector<double>(c.params().begin() + 4, c.params().begin() + 9), true); };
+  const Eigen::Matrix3d rotation = rig.right_from_left.rotation.toRotationMatrix();
+  cv::Matx33d r;
+  for (int i = 0; i < 9; ++i) r.val[i] = rotation(i / 3, i % 3);
+  const Eigen::Vector3d& t = rig.right_from_left.translation;
+  cv::stereoRectify(k(rig.left), d(rig.left), k(rig.right), d(rig.right), cv::Size(kWidth, kHeight), r,
+                    cv::Vec3d(t.x(), t.y(), t.z()) / 1000.0, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY, 0.3);
+  const auto camera_info = [&](const fs::path& file, const Camera& camera, const cv::Mat& rectification, const cv::Mat& projection) {
+    const auto eigen = [](const cv::Mat& m) {
+      Eigen::MatrixXd e(m.rows, m.cols);
+      for (int i = 0; i < m.rows; ++i) for (int j = 0; j < m.cols; ++j) e(i, j) = m.at<double>(i, j);
+      return e;
+    };
+    const std::vector<double>& p = camera.params();
+    std::ofstream(file) << "image_width: 320\nimage_height: 240\ncamera_name: narrow_stereo\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: "
+                        << FlowList(eigen(cv::Mat(k(camera)))) << "\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: "
+                        << FlowList(Eigen::Matrix<double, 1, 5>(p[4], p[5], p[6], p[7], p[8])) << "\nrectification_matrix:\n  rows: 3\n  cols: 3\n  data: "
+                        << FlowList(eigen(rectification)) << "\nprojection_matrix:\n  rows: 3\n  cols: 4\n  data: " << FlowList(eigen(projection)) << "\n";
+  };
+  camera_info(folder / "left.yaml", rig.left, r1, p1);
+  camera_info(folder / "right.yaml", rig.right, r2, p2);
+  const StereoCalibration ros = ReadStereoCalibration({folder / "left.yaml", folder / "right.yaml"}, std::nullopt, 0.0);
+  EXPECT_LT(ros.right_from_left.rotation.angularDistance(rig.right_from_left.rotation), 1e-9);
+  EXPECT_LT((ros.right_from_left.translation - rig.right_from_left.translation).norm(), 1e-6);  // mm
+  EXPECT_EQ(ros.right.params(), rig.right.params());
+
+  // One camera_info alone is not a pair.
+  EXPECT_NE(ErrorMessage([&] { ReadStereoCalibration({folder / "left.yaml"}, std::nullopt, 0.0); }).find("not a stereo calibration"),
+            std::string::npos);
+  fs::remove_all(folder);
+}
+
 std::string StereoError(const ImportOptions& options, const fs::path& out) {
   return ErrorMessage([&] { ImportDataset(options, out); });
 }
@@ -292,7 +374,7 @@ TEST(StereoRectification, RefusesWhatCannotBeASideBySidePair) {
   WriteCalibration(rig, folder / "intrinsics.yml", folder / "extrinsics.yml", rig.right_from_left.translation);
 
   ImportOptions options = StereoImport(folder);
-  options.extrinsics.clear();
+  options.second_calibration.clear();
   EXPECT_NE(StereoError(options, folder / "out").find("no 'R'"), std::string::npos);
   options = StereoImport(folder);
   options.stereo_layout = "side-by-side";

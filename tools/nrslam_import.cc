@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   app.add_option("--format", options.format, "endomapper-sim, hamlyn, c3vd, images or stereo")->required();
   app.add_option("--in", options.input, "the dataset's folder (or a video file for --format images and stereo)")->required();
   app.add_option("--out", out, "sequence folder to write")->required();
-  app.add_option("--calibration", options.calibration, "camera JSON (as in sequence.json), OCamCalib's calib_results.txt or an OpenCV / ROS calibration (.yml, .yaml, .xml); c3vd and images need one; stereo needs the pair's OpenCV stereo calibration (M1 D1 M2 D2 R T)");
+  app.add_option("--calibration", options.calibration, "camera JSON (as in sequence.json), OCamCalib's calib_results.txt or an OpenCV / ROS calibration (.yml, .yaml, .xml); c3vd and images need one; stereo needs the pair's stereo calibration (OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain, or ROS camera_info with --second-calibration)");
   app.add_option("--mask", options.mask,
                  "fixed validity mask of the images (non-zero = usable), e.g. the black border of an endoscope's image");
   app.add_option("--fps", options.fps, "frames per second")->capture_default_str();
@@ -30,9 +30,10 @@ int main(int argc, char** argv) {
   app.add_option("--right", options.right, "stereo: the right camera's images (folder or video)");
   app.add_option("--stereo-layout", options.stereo_layout,
                  "stereo: both views in each input image, side-by-side (left half = left camera) or top-bottom (top = left)");
-  app.add_option("--extrinsics", options.extrinsics,
-                 "stereo: a second calibration file with what the first lacks (R and T of OpenCV's stereo_calib extrinsics.yml)");
-  app.add_option("--stereo-unit-mm", options.stereo_unit_mm, "stereo: mm per unit of the calibration's T (1000 if metres)")
+  app.add_option("--second-calibration", options.second_calibration,
+                 "stereo: a second calibration file: R and T of OpenCV's stereo_calib extrinsics.yml, or the right camera's ROS camera_info");
+  app.add_option("--stereo-unit-mm", options.stereo_unit_mm,
+                 "stereo: mm per unit of the calibration's translation; 0 = the format's own (OpenCV's names: mm; Kalibr, ROS: metres)")
       ->capture_default_str();
   std::string rectified_size;
   app.add_option("--rectified-size", rectified_size,

@@ -24,7 +24,7 @@ const std::set<std::string> kExternalKeys = {"estimates", "trajectory", "stride"
 // The keys of an "import" object: nrslam_import's options by their long names.
 const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
                                            "depth_unit_mm", "near", "far", "scene_unit_mm", "scale", "mask",
-                                           "right", "stereo_layout", "extrinsics", "stereo_unit_mm",
+                                           "right", "stereo_layout", "second_calibration", "stereo_unit_mm",
                                            "rectified_size", "rectify_alpha", "stereo_depth"};
 
 void Require(bool condition, const std::string& context, const std::string& message) {
@@ -100,7 +100,7 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
     for (const auto& [key, value] : import.items()) {
       Require(kImportKeys.count(key) > 0, context, "import: unknown key '" + key + "'");
       std::string text = value.is_string() ? value.get<std::string>() : value.dump();
-      if (key == "path" || key == "calibration" || key == "mask" || key == "right" || key == "extrinsics") text = FromManifest(text, folder).string();
+      if (key == "path" || key == "calibration" || key == "mask" || key == "right" || key == "second_calibration") text = FromManifest(text, folder).string();
       std::string option = key == "path" ? "in" : key;
       std::replace(option.begin(), option.end(), '_', '-');
       Require(value.is_boolean() == (key == "stereo_depth"), context,

@@ -288,7 +288,8 @@ FrameSource Images(const ImportOptions& options) {
 // hold both (side by side, or the left above the right), rectified with the pair's calibration.
 FrameSource Stereo(const ImportOptions& options) {
   if (options.calibration.empty()) {
-    Fail(options, "needs --calibration: the pair's OpenCV stereo calibration (M1, D1, M2, D2, R, T)");
+    Fail(options, "needs --calibration: the pair's stereo calibration (OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain, or "
+                  "the left camera's ROS camera_info with the right one's as --second-calibration)");
   }
   const bool packed = !options.stereo_layout.empty();
   if (packed == !options.right.empty()) {
@@ -320,7 +321,7 @@ FrameSource Stereo(const ImportOptions& options) {
   };
   const cv::Mat first = packed ? half(decoded->second, 0, 0) : decoded->second;
   std::vector<fs::path> calibration_files = {options.calibration};
-  if (!options.extrinsics.empty()) calibration_files.push_back(options.extrinsics);
+  if (!options.second_calibration.empty()) calibration_files.push_back(options.second_calibration);
   StereoCalibration calibration;
   try {
     calibration = ReadStereoCalibration(calibration_files, std::make_pair(first.cols, first.rows), options.stereo_unit_mm);
@@ -421,15 +422,15 @@ void ImportOptions::Check() const {
     throw Error("import options: need fps > 0, max_frames >= 0, depth_unit_mm > 0, 0 < near < far, scene_unit_mm > 0");
   }
   if (!(scale > 0 && scale <= 4)) throw Error("import options: scale must be in (0, 4], got " + std::to_string(scale));
-  const bool stereo_option = !right.empty() || !extrinsics.empty() || !stereo_layout.empty() || rectified_width != 0 ||
-                             rectified_height != 0 || rectify_alpha != 0.0 || stereo_unit_mm != 1.0;
+  const bool stereo_option = !right.empty() || !second_calibration.empty() || !stereo_layout.empty() || rectified_width != 0 ||
+                             rectified_height != 0 || rectify_alpha != 0.0 || stereo_unit_mm != 0.0;
   if (stereo_option && format != "stereo") {
-    throw Error("import options: the right images, stereo layout, extrinsics and rectification apply to --format stereo only");
+    throw Error("import options: the right images, stereo layout, second calibration and rectification apply to --format stereo only");
   }
   if (!stereo_layout.empty() && stereo_layout != "side-by-side" && stereo_layout != "top-bottom") {
     throw Error("import options: stereo layout must be side-by-side or top-bottom, got '" + stereo_layout + "'");
   }
-  if (!(stereo_unit_mm > 0)) throw Error("import options: stereo_unit_mm must be > 0");
+  if (stereo_unit_mm < 0) throw Error("import options: stereo_unit_mm must be > 0 (or 0: the calibration format's own)");
   StereoRectificationOptions{rectified_width, rectified_height, rectify_alpha}.Check();
 }
 

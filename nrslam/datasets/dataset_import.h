@@ -14,7 +14,7 @@
 //                   file; no ground truth (runs need monocular initialisation).
 //   stereo          a raw stereo recording: the left images (folder or video) and the right
 //                   ones, or one stream holding both views side by side or one above the other,
-//                   with the pair's OpenCV stereo calibration (io/camera_file.h); rectified
+//                   with the pair's stereo calibration (io/camera_file.h); rectified
 //                   (datasets/stereo_rectification.h) into a pinhole pair with its baseline, so
 //                   nrslam_stereo_gt can give it depth. No ground truth.
 //
@@ -51,10 +51,13 @@ struct ImportOptions {
   // half is the left camera, as SCARED's videos).
   std::filesystem::path right;
   std::string stereo_layout;
-  // stereo: a second calibration file with the entries the first lacks (OpenCV's stereo_calib
-  // sample writes M1 D1 M2 D2 to intrinsics.yml and R T to extrinsics.yml); empty = none.
-  std::filesystem::path extrinsics;
-  double stereo_unit_mm = 1.0;  // stereo: mm per unit of the calibration's T (1000 when in metres)
+  // stereo: a second calibration file: the entries the first lacks (OpenCV's stereo_calib sample
+  // writes M1 D1 M2 D2 to intrinsics.yml and R T to extrinsics.yml), or the right camera's ROS
+  // camera_info when `calibration` is the left one's; empty = none (io/camera_file.h).
+  std::filesystem::path second_calibration;
+  // stereo: mm per unit of the calibration's translation; 0 = the format's own (mm for OpenCV's
+  // names, as SCARED's; metres for Kalibr and ROS).
+  double stereo_unit_mm = 0.0;
   // stereo: the rectified images' size, px (0 × 0 = automatic) and cv::stereoRectify's alpha
   // (see StereoRectificationOptions).
   int rectified_width = 0, rectified_height = 0;

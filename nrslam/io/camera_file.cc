@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <fstream>
 #include <optional>
@@ -57,9 +58,9 @@ std::vector<double> EntryNumbers(const cv::FileNode& node, const std::string& ke
 }
 
 // The first of `keys` the file has: its key and node; an empty key when none is there.
-std::pair<std::string, cv::FileNode> FirstEntry(const cv::FileStorage& storage, std::initializer_list<const char*> keys) {
+std::pair<std::string, cv::FileNode> FirstEntry(const cv::FileNode& map, std::initializer_list<const char*> keys) {
   for (const char* key : keys) {
-    const cv::FileNode node = storage[key];
+    const cv::FileNode node = map[key];
     if (!node.empty() && !node.isNone()) return {key, node};
   }
   return {"", cv::FileNode()};
@@ -82,13 +83,35 @@ bool IsOpenCvCalibration(const std::filesystem::path& file, char first) {
   return first == '%' || first == '<' || extension == ".yml" || extension == ".yaml" || extension == ".xml";
 }
 
+// YAML text with every block sequence indented deeper than its key. YAML lets the items of
+// "key:" sit at the key's own indentation (Kalibr writes T_cn_cnm1 so); OpenCV's reader does not.
+std::string WithIndentedSequences(const std::string& yaml) {
+  std::istringstream lines(yaml);
+  std::string line, result;
+  size_t key_indent = std::string::npos;  // indentation of the "key:" line whose items may follow
+  while (std::getline(lines, line)) {
+    const size_t indent = line.find_first_not_of(' ');
+    const bool item = indent != std::string::npos && line.compare(indent, 2, "- ") == 0;
+    if (item && indent == key_indent) {
+      line.insert(0, "  ");
+    } else {
+      const size_t end = line.find_last_not_of(" \t\r");
+      key_indent = end != std::string::npos && line[end] == ':' ? indent : std::string::npos;
+    }
+    result += line + '\n';
+  }
+  return result;
+}
+
 // The file opened by cv::FileStorage from its text. OpenCV's YAML reader wants the version
-// directive its writer puts first; ROS leaves it out, so it is added when missing.
+// directive its writer puts first; ROS and Kalibr leave it out, so it is added when missing.
 cv::FileStorage OpenCalibrationStorage(const std::filesystem::path& file) {
   std::string contents = FileText(file);
   const size_t first = contents.find_first_not_of(" \t\r\n");
-  if (first != std::string::npos && contents[first] != '%' && contents[first] != '<') {
-    contents = "%YAML:1.0\n---\n" + contents;
+  const char lead = first == std::string::npos ? '\0' : contents[first];
+  if (lead != '\0' && lead != '<') {  // YAML
+    contents = WithIndentedSequences(contents);
+    if (lead != '%') contents = "%YAML:1.0\n---\n" + contents;
   }
   cv::FileStorage storage;
   try {
@@ -108,10 +131,10 @@ std::string KeyList(std::initializer_list<const char*> keys) {
 
 // The image size the file states (image_width and image_height, or image_size / imageSize as
 // [width, height]); `fallback` when it states none and the caller knows it, else Error.
-std::pair<int, int> CalibrationImageSize(const cv::FileStorage& storage, std::optional<std::pair<int, int>> fallback) {
-  const auto [size_key, size_node] = FirstEntry(storage, {"image_size", "imageSize"});
-  if (!storage["image_width"].empty() && !storage["image_height"].empty()) {
-    return {static_cast<int>(storage["image_width"]), static_cast<int>(storage["image_height"])};
+std::pair<int, int> CalibrationImageSize(const cv::FileNode& map, std::optional<std::pair<int, int>> fallback) {
+  const auto [size_key, size_node] = FirstEntry(map, {"image_size", "imageSize", "resolution"});
+  if (!map["image_width"].empty() && !map["image_height"].empty()) {
+    return {static_cast<int>(map["image_width"]), static_cast<int>(map["image_height"])};
   }
   if (!size_key.empty()) {
     const std::vector<double> size = EntryNumbers(size_node, size_key);
@@ -124,9 +147,9 @@ std::pair<int, int> CalibrationImageSize(const cv::FileStorage& storage, std::op
 
 // One camera of the file: its matrix under the first of `matrix_keys` it has, its distortion
 // under the first of `distortion_keys` (none = pinhole), its model from distortion_model.
-Camera ReadOpenCvCamera(const cv::FileStorage& storage, std::initializer_list<const char*> matrix_keys,
+Camera ReadOpenCvCamera(const cv::FileNode& map, std::initializer_list<const char*> matrix_keys,
                         std::initializer_list<const char*> distortion_keys, std::pair<int, int> size) {
-  const auto [matrix_key, matrix_node] = FirstEntry(storage, matrix_keys);
+  const auto [matrix_key, matrix_node] = FirstEntry(map, matrix_keys);
   if (matrix_key.empty()) throw Error("no camera matrix (" + KeyList(matrix_keys) + ")");
   const std::vector<double> k = EntryNumbers(matrix_node, matrix_key);
   if (k.size() != 9) throw Error("'" + matrix_key + "' must be 3x3, has " + std::to_string(k.size()) + " numbers");
@@ -135,10 +158,10 @@ Camera ReadOpenCvCamera(const cv::FileStorage& storage, std::initializer_list<co
   }
   const auto [width, height] = size;
 
-  const auto [distortion_key, distortion_node] = FirstEntry(storage, distortion_keys);
+  const auto [distortion_key, distortion_node] = FirstEntry(map, distortion_keys);
   std::vector<double> distortion =
       distortion_key.empty() ? std::vector<double>() : EntryNumbers(distortion_node, distortion_key);
-  const cv::FileNode model_node = storage["distortion_model"];
+  const cv::FileNode model_node = map["distortion_model"];
   const std::string model = model_node.isString() ? Lowercase(static_cast<std::string>(model_node)) : "";
   const bool fisheye = model == "equidistant" || model == "fisheye" || model == "kannala_brandt";
   if (!model.empty() && !fisheye && model != "plumb_bob" && model != "radtan" && model != "rational_polynomial") {
@@ -168,10 +191,101 @@ Camera ReadOpenCvCamera(const cv::FileStorage& storage, std::initializer_list<co
 
 Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
   const cv::FileStorage storage = OpenCalibrationStorage(file);
-  return ReadOpenCvCamera(storage, {"camera_matrix", "cameraMatrix", "K", "M1"},
+  return ReadOpenCvCamera(storage.root(), {"camera_matrix", "cameraMatrix", "K", "M1"},
                           {"distortion_coefficients", "dist_coeffs", "distCoeffs", "D", "D1"},
-                          CalibrationImageSize(storage, std::nullopt));
+                          CalibrationImageSize(storage.root(), std::nullopt));
 }
+
+namespace {
+
+Eigen::Matrix3d Rotation(const std::vector<double>& row_major, const std::string& key) {
+  if (row_major.size() != 9) throw Error("'" + key + "' must be a 3x3 rotation, has " + std::to_string(row_major.size()) + " numbers");
+  const Eigen::Matrix3d rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(row_major.data());
+  if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3 || rotation.determinant() < 0) {
+    throw Error("'" + key + "' is not a rotation");
+  }
+  return rotation;
+}
+
+// OpenCV's names, from whichever file has each: OpenCV's stereo_calib sample writes the
+// intrinsics (M1 D1 M2 D2) and the extrinsics (R T) to two files.
+StereoCalibration OpenCvStereo(const std::vector<cv::FileStorage>& storages, std::optional<std::pair<int, int>> image_size,
+                               double translation_unit_mm) {
+  const auto holding = [&](const char* key) -> cv::FileNode {
+    for (const cv::FileStorage& storage : storages) {
+      if (!FirstEntry(storage.root(), {key}).first.empty()) return storage.root();
+    }
+    throw Error(std::string("no '") + key + "'");
+  };
+  const std::pair<int, int> size = CalibrationImageSize(holding("M1"), image_size);
+  StereoCalibration stereo;
+  stereo.left = ReadOpenCvCamera(holding("M1"), {"M1"}, {"D1"}, size);
+  stereo.right = ReadOpenCvCamera(holding("M2"), {"M2"}, {"D2"}, size);
+  const Eigen::Matrix3d rotation = Rotation(EntryNumbers(holding("R")["R"], "R"), "R");
+  const std::vector<double> t = EntryNumbers(holding("T")["T"], "T");
+  if (t.size() != 3) throw Error("'T' must be 3 numbers, has " + std::to_string(t.size()));
+  stereo.right_from_left = Rigid3(Eigen::Quaterniond(rotation), Eigen::Vector3d(t[0], t[1], t[2]) * translation_unit_mm);
+  return stereo;
+}
+
+// One camera of Kalibr's camchain: pinhole with radtan (OpenCV's k1 k2 p1 p2), equidistant
+// (Kannala–Brandt) or no distortion.
+Camera KalibrCamera(const cv::FileNode& node, const std::string& name) {
+  const std::string model = node["camera_model"].isString() ? static_cast<std::string>(node["camera_model"]) : "";
+  if (model != "pinhole") throw Error(name + ": camera_model '" + model + "' (only Kalibr's pinhole model is read)");
+  const std::vector<double> intrinsics = EntryNumbers(node["intrinsics"], name + ".intrinsics");
+  if (intrinsics.size() != 4) throw Error(name + ".intrinsics must be [fu, fv, pu, pv]");
+  const std::pair<int, int> size = CalibrationImageSize(node, std::nullopt);
+  const std::string distortion = node["distortion_model"].isString() ? static_cast<std::string>(node["distortion_model"]) : "none";
+  const std::vector<double> k =
+      node["distortion_coeffs"].empty() ? std::vector<double>() : EntryNumbers(node["distortion_coeffs"], name + ".distortion_coeffs");
+  const auto [fx, fy, cx, cy] = std::array<double, 4>{intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3]};
+  const bool undistorted = std::all_of(k.begin(), k.end(), [](double d) { return d == 0.0; });
+  if (distortion == "none" || undistorted) return Camera::Pinhole(size.first, size.second, fx, fy, cx, cy);
+  if (k.size() != 4) throw Error(name + ".distortion_coeffs must hold 4 numbers");
+  if (distortion == "radtan") return Camera::OpenCv(size.first, size.second, fx, fy, cx, cy, k);
+  if (distortion == "equidistant") return Camera::KannalaBrandt(size.first, size.second, fx, fy, cx, cy, Eigen::Vector4d(k[0], k[1], k[2], k[3]));
+  throw Error(name + ": distortion_model '" + distortion + "' (known: radtan, equidistant, none)");
+}
+
+// Kalibr's camchain: cam0 and cam1, with cam1's T_cn_cnm1 taking cam0's coordinates to its own.
+StereoCalibration KalibrStereo(const cv::FileStorage& storage, double translation_unit_mm) {
+  StereoCalibration stereo;
+  stereo.left = KalibrCamera(storage["cam0"], "cam0");
+  stereo.right = KalibrCamera(storage["cam1"], "cam1");
+  std::vector<double> matrix;
+  for (const cv::FileNode& row : storage["cam1"]["T_cn_cnm1"]) {
+    const std::vector<double> numbers = EntryNumbers(row, "cam1.T_cn_cnm1");
+    matrix.insert(matrix.end(), numbers.begin(), numbers.end());
+  }
+  if (matrix.size() != 16) throw Error("cam1.T_cn_cnm1 must be a 4x4 matrix");
+  const std::vector<double> rotation = {matrix[0], matrix[1], matrix[2], matrix[4], matrix[5], matrix[6], matrix[8], matrix[9], matrix[10]};
+  stereo.right_from_left = Rigid3(Eigen::Quaterniond(Rotation(rotation, "cam1.T_cn_cnm1")),
+                                  Eigen::Vector3d(matrix[3], matrix[7], matrix[11]) * translation_unit_mm);
+  return stereo;
+}
+
+// A ROS camera_info pair, already rectified by ROS's stereo calibrator: each camera's raw lens,
+// its rectifying rotation R_i and projection P_i. Rectified coordinates differ by the baseline
+// along x (P_right's Tx = −f·B), so x_right = R_r^T (R_l x_left + (Tx/f, Ty/f, 0)).
+StereoCalibration RosStereo(const cv::FileStorage& left, const cv::FileStorage& right, double translation_unit_mm) {
+  const auto camera = [](const cv::FileStorage& storage) {
+    return ReadOpenCvCamera(storage.root(), {"camera_matrix"}, {"distortion_coefficients"},
+                            CalibrationImageSize(storage.root(), std::nullopt));
+  };
+  StereoCalibration stereo;
+  stereo.left = camera(left);
+  stereo.right = camera(right);
+  const Eigen::Matrix3d r_left = Rotation(EntryNumbers(left["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
+  const Eigen::Matrix3d r_right = Rotation(EntryNumbers(right["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
+  const std::vector<double> p = EntryNumbers(right["projection_matrix"], "projection_matrix");
+  if (p.size() != 12) throw Error("the right camera's projection_matrix must be 3x4");
+  const Eigen::Vector3d offset(p[3] / p[0], p[7] / p[5], 0.0);
+  stereo.right_from_left = Rigid3(Eigen::Quaterniond(r_right.transpose() * r_left), r_right.transpose() * offset * translation_unit_mm);
+  return stereo;
+}
+
+}  // namespace
 
 StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>& files,
                                         std::optional<std::pair<int, int>> image_size, double translation_unit_mm) {
@@ -179,30 +293,27 @@ StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>
   for (const std::filesystem::path& file : files) names += (names.empty() ? "" : ", ") + file.string();
   try {
     if (files.empty()) throw Error("no file given");
-    if (!(translation_unit_mm > 0)) throw Error("the unit of T must be > 0 mm");
+    if (translation_unit_mm < 0) throw Error("the unit of the translation must be > 0 mm (0: the format's own)");
     std::vector<cv::FileStorage> storages;
     for (const std::filesystem::path& file : files) storages.push_back(OpenCalibrationStorage(file));
-    // Each entry comes from the first file that has it: OpenCV's stereo_calib sample writes the
-    // intrinsics (M1 D1 M2 D2) and the extrinsics (R T) to two files.
-    const auto holding = [&](const char* key) -> const cv::FileStorage& {
-      for (const cv::FileStorage& storage : storages) {
-        if (!FirstEntry(storage, {key}).first.empty()) return storage;
-      }
-      throw Error(std::string("no '") + key + "'");
-    };
-    const std::pair<int, int> size = CalibrationImageSize(holding("M1"), image_size);
+    const auto has = [](const cv::FileStorage& storage, const char* key) { return !FirstEntry(storage.root(), {key}).first.empty(); };
+    const bool opencv = std::any_of(storages.begin(), storages.end(), [&](const cv::FileStorage& s) { return has(s, "M1"); });
+    const bool kalibr = has(storages[0], "cam0") && has(storages[0], "cam1");
+    const bool ros = storages.size() == 2 && has(storages[0], "projection_matrix") && has(storages[1], "projection_matrix");
+    // The formats' own units: OpenCV's files carry the unit their calibration target was
+    // measured in (mm for SCARED); Kalibr and ROS use metres.
+    const double unit = translation_unit_mm > 0 ? translation_unit_mm : opencv ? 1.0 : 1000.0;
     StereoCalibration stereo;
-    stereo.left = ReadOpenCvCamera(holding("M1"), {"M1"}, {"D1"}, size);
-    stereo.right = ReadOpenCvCamera(holding("M2"), {"M2"}, {"D2"}, size);
-    const std::vector<double> r = EntryNumbers(holding("R")["R"], "R");
-    const std::vector<double> t = EntryNumbers(holding("T")["T"], "T");
-    if (r.size() != 9) throw Error("'R' must be a 3x3 rotation, has " + std::to_string(r.size()) + " numbers");
-    if (t.size() != 3) throw Error("'T' must be 3 numbers, has " + std::to_string(t.size()));
-    const Eigen::Matrix3d rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
-    if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3 || rotation.determinant() < 0) {
-      throw Error("'R' is not a rotation");
+    if (opencv) {
+      stereo = OpenCvStereo(storages, image_size, unit);
+    } else if (kalibr) {
+      stereo = KalibrStereo(storages[0], unit);
+    } else if (ros) {
+      stereo = RosStereo(storages[0], storages[1], unit);
+    } else {
+      throw Error("not a stereo calibration: expected OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain (cam0, cam1) or two "
+                  "ROS camera_info files (left, right)");
     }
-    stereo.right_from_left = Rigid3(Eigen::Quaterniond(rotation), Eigen::Vector3d(t[0], t[1], t[2]) * translation_unit_mm);
     stereo.left.Check();
     stereo.right.Check();
     return stereo;

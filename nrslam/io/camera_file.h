@@ -45,12 +45,19 @@ struct StereoCalibration {
   Rigid3 right_from_left;  // translation in mm
 };
 
-// A stereo calibration in OpenCV's names (cv::FileStorage YAML or XML): M1, D1, M2, D2, R and T,
-// as OpenCV's stereo_calib sample and the SCARED dataset write them. Each entry is taken from the
-// first of `files` that has it (the sample writes intrinsics.yml and extrinsics.yml). The image
-// size is the file's (as ReadOpenCvCalibration reads it) or else `image_size` (width, height); T
-// is in units of `translation_unit_mm` (1 when in mm, 1000 when in metres). Both cameras share
-// one distortion_model. Throws Error naming the files and what is missing or wrong.
+// A stereo pair's calibration (cv::FileStorage YAML or XML), in one of three forms:
+//  - OpenCV's names: M1, D1, M2, D2, R and T, as cv::stereoCalibrate gives them, OpenCV's
+//    stereo_calib sample writes them and the SCARED dataset ships them; each entry is taken
+//    from the first of `files` that has it (the sample writes intrinsics.yml and extrinsics.yml).
+//    The image size is the file's (as ReadOpenCvCalibration reads it) or else `image_size`
+//    (width, height).
+//  - Kalibr's camchain: cam0 and cam1 (camera_model pinhole; distortion_model radtan,
+//    equidistant or none; intrinsics, distortion_coeffs, resolution), cam1's T_cn_cnm1.
+//  - two ROS camera_info files, left then right, with ROS's rectification (rectification_matrix,
+//    projection_matrix), from which the pair's relative pose is recovered.
+// The translation is in units of `translation_unit_mm` (0: the format's own: mm for OpenCV's
+// names, as SCARED's; metres for Kalibr and ROS). Throws Error naming the files and what is
+// missing or wrong.
 StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>& files,
                                         std::optional<std::pair<int, int>> image_size, double translation_unit_mm);
 
