@@ -218,6 +218,17 @@ TEST(StereoRectification, ARawDistortedPairGivesThePlanesTrueDepth) {
     EXPECT_GT(coverage, 0.8);
     EXPECT_LT(median, 0.5);
   }
+  // Halved on import, the depth is still matched at the recording's size, then resized: as
+  // accurate as unhalved (measured 0.31 mm; matched after halving, with half the disparity, 0.70).
+  options.scale = 0.5;
+  const SequenceInfo half = ImportDataset(options, folder / "half");
+  EXPECT_EQ(half.camera.width(), kWidth / 2);
+  double half_coverage = 0;
+  const double half_median =
+      MedianDepthError(SequenceReader(folder / "half").ReadDepthMm(0), half.camera, rectified_from_left, &half_coverage);
+  std::printf("halved: stereo depth on %.1f %% of the pixels, median |error| %.3f mm\n", 100 * half_coverage, half_median);
+  EXPECT_GT(half_coverage, 0.7);
+  EXPECT_LT(half_median, 0.5);
   // The control: the raw pair read as if it were rectified (left intrinsics, |T|) is far off,
   // so the figures above are the rectification's.
   double raw_coverage = 0;
