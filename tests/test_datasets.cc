@@ -232,6 +232,18 @@ TEST(DatasetImport, C3vdDepthScaleAndBothPoseOrders) {
     EXPECT_NEAR(sequence.ReadDepthMm(1).at<float>(3, 3), 40.0, 0.01);
     ASSERT_EQ(sequence.groundtruth().size(), static_cast<size_t>(kFrames));
     for (int i = 0; i < kFrames; ++i) ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-4);
+    // Every other frame: frames 0 and 2, with their depth, poses and times, at half the rate.
+    options.frame_step = 2;
+    fs::remove_all(out);
+    ImportDataset(options, out);
+    const SequenceReader halved(out);
+    ASSERT_EQ(halved.frame_count(), 2);
+    EXPECT_DOUBLE_EQ(halved.info().fps, 15.0);
+    EXPECT_NEAR(halved.ReadDepthMm(1).at<float>(3, 3), 60.0, 0.01);
+    ASSERT_EQ(halved.groundtruth().size(), 2u);
+    ExpectSamePose(halved.groundtruth()[1].world_from_camera, Pose(2), 1e-4);
+    EXPECT_NEAR(halved.groundtruth()[1].timestamp, 2 / 30.0, 1e-9);  // TUM files keep 12 digits
+    EXPECT_EQ(halved.info().provenance.at("frame_step"), 2);
     fs::remove_all(in);
     fs::remove_all(out);
   }
@@ -296,6 +308,24 @@ TEST(DatasetImport, PlainImageFolderAndVideoWithACalibration) {
   options.input = in / "clip.avi";
   ImportDataset(options, out);
   EXPECT_EQ(SequenceReader(out).frame_count(), 5);
+  // Every other frame of a video whose frame i is grey level 40·i: 0, 2 and 4 are kept.
+  {
+    cv::VideoWriter video((in / "levels.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30,
+                          cv::Size(kWidth, kHeight));
+    for (int i = 0; i < 6; ++i) video.write(cv::Mat(kHeight, kWidth, CV_8UC3, cv::Scalar::all(40 * i)));
+  }
+  fs::remove_all(out);
+  options.input = in / "levels.avi";
+  options.frame_step = 2;
+  ImportDataset(options, out);
+  {
+    const SequenceReader sequence(out);
+    ASSERT_EQ(sequence.frame_count(), 3);
+    EXPECT_DOUBLE_EQ(sequence.info().fps, 15.0);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(cv::mean(sequence.ReadRgb(i))[0], 80 * i, 3) << i;
+  }
+  options.input = in / "clip.avi";
+  options.frame_step = 1;
   // Another sequence's sequence.json serves as the calibration: its "camera" is read.
   fs::copy(out / "sequence.json", in / "sequence.json");
   options.calibration = in / "sequence.json";

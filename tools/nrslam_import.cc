@@ -21,8 +21,11 @@ int main(int argc, char** argv) {
   app.add_option("--calibration", options.calibration, "camera JSON (as in sequence.json), OCamCalib's calib_results.txt or an OpenCV / ROS calibration (.yml, .yaml, .xml); c3vd and images need one; stereo needs the pair's stereo calibration (OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain, or ROS camera_info with --second-calibration)");
   app.add_option("--mask", options.mask,
                  "fixed validity mask of the images (non-zero = usable), e.g. the black border of an endoscope's image");
-  app.add_option("--fps", options.fps, "frames per second")->capture_default_str();
+  app.add_option("--fps", options.fps, "the dataset's frames per second")->capture_default_str();
   app.add_option("--max-frames", options.max_frames, "import at most this many frames (0 = all)")->capture_default_str();
+  app.add_option("--frame-step", options.frame_step,
+                 "keep every Nth frame (2 turns a 50 fps video into 25 fps; the sequence's fps is divided by it)")
+      ->capture_default_str();
   app.add_option("--depth-unit-mm", options.depth_unit_mm, "resolution of the written depth, mm")->capture_default_str();
   app.add_option("--scale", options.scale,
                  "resize every image, depth map and the calibration by this factor, in (0, 4] (0.5 halves 1440x1080 to 720x540)")

@@ -22,7 +22,7 @@ const std::set<std::string> kRunKeys = {"set", "init", "rigid", "first_frame", "
 const std::set<std::string> kExternalKeys = {"estimates", "trajectory", "stride", "name"};
 
 // The keys of an "import" object: nrslam_import's options by their long names.
-const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames",
+const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames", "frame_step",
                                            "depth_unit_mm", "near", "far", "scene_unit_mm", "scale", "mask",
                                            "right", "stereo_layout", "second_calibration", "stereo_unit_mm",
                                            "rectified_size", "rectify_alpha", "stereo_depth"};

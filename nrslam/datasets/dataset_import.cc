@@ -266,9 +266,13 @@ FrameStream OpenFrames(const ImportOptions& options, const fs::path& input) {
   while (counter.grab()) ++stream.count;
   if (stream.count == 0) Fail(options, "the video " + input.string() + " has no frames");
   auto video = std::make_shared<cv::VideoCapture>(input.string());
-  stream.read = [&options, video, input](int i) {
+  auto next = std::make_shared<int>(0);  // the frame the video decodes next
+  stream.read = [&options, video, next, input](int i) {
+    if (i < *next) Fail(options, "frame " + std::to_string(i) + " of " + input.string() + " asked for after frame " + std::to_string(*next));
     cv::Mat frame;
-    if (!video->read(frame)) Fail(options, "cannot decode frame " + std::to_string(i) + " of " + input.string());
+    while (*next < i && video->grab()) ++*next;  // frames skipped (--frame-step) are not decoded
+    if (*next != i || !video->read(frame)) Fail(options, "cannot decode frame " + std::to_string(i) + " of " + input.string());
+    ++*next;
     return frame;
   };
   return stream;
@@ -386,26 +390,30 @@ void WriteFrames(const ImportOptions& options, const FrameSource& source, int co
                  const SequenceWriter& writer) {
   const cv::Size size(source.camera.width(), source.camera.height());
   for (int i = 0; i < count; ++i) {
-    const cv::Mat rgb = source.rgb(i);
+    const int from = i * options.frame_step;  // the dataset's frame that becomes frame i
+    const cv::Mat rgb = source.rgb(from);
     if (rgb.size() != size) {
-      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
+      Fail(options, "frame " + std::to_string(from) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
                         " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
     }
     writer.WriteRgb(i, Resized(rgb, written, false));
-    const cv::Mat right = source.right ? source.right(i) : cv::Mat();
+    const cv::Mat right = source.right ? source.right(from) : cv::Mat();
     if (!right.empty()) writer.WriteRight(i, Resized(right, written, false));
     if (source.depth_mm || options.stereo_depth) {
       // Stereo depth is matched at the source's size, before any --scale: ground truth as fine as
       // the recording gives (halved first, the test's plane came out 2.3× less accurate).
-      const cv::Mat depth = source.depth_mm ? source.depth_mm(i)
+      const cv::Mat depth = source.depth_mm ? source.depth_mm(from)
                                             : StereoDepthMm(rgb, right, source.camera.fx(), source.baseline_mm, StereoDepthOptions{});
-      if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(i) + " has another size than the image");
+      if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(from) + " has another size than the image");
       writer.WriteDepthMm(i, Resized(depth, written, true));
     }
   }
   if (!source.world_from_camera.empty()) {
     std::vector<StampedPose> poses;
-    for (int i = 0; i < count; ++i) poses.push_back({i / options.fps, source.world_from_camera[i]});
+    for (int i = 0; i < count; ++i) {
+      const int from = i * options.frame_step;
+      poses.push_back({from / options.fps, source.world_from_camera[static_cast<size_t>(from)]});
+    }
     writer.WriteGroundtruth(poses);
   }
 }
@@ -420,6 +428,7 @@ void ImportOptions::Check() const {
     throw Error("unknown dataset format '" + format + "' (known: " + known + ")");
   }
   if (!fs::exists(input)) throw Error(format + " dataset: " + input.string() + " does not exist");
+  if (frame_step < 1) throw Error("import options: frame_step must be >= 1, got " + std::to_string(frame_step));
   if (!(fps > 0) || max_frames < 0 || !(depth_unit_mm > 0) || !(near > 0) || !(far > near) || !(scene_unit_mm > 0)) {
     throw Error("import options: need fps > 0, max_frames >= 0, depth_unit_mm > 0, 0 < near < far, scene_unit_mm > 0");
   }
@@ -447,13 +456,14 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
                        : options.format == "c3vd"         ? C3vd(options)
                        : options.format == "stereo"       ? Stereo(options)
                                                           : Images(options);
-  const int count = options.max_frames > 0 ? std::min(options.max_frames, source.count) : source.count;
+  const int kept = (source.count + options.frame_step - 1) / options.frame_step;
+  const int count = options.max_frames > 0 ? std::min(options.max_frames, kept) : kept;
   SequenceInfo info;
   info.camera = options.scale == 1.0
                     ? source.camera
                     : source.camera.Resized(std::max(1, static_cast<int>(std::lround(source.camera.width() * options.scale))),
                                             std::max(1, static_cast<int>(std::lround(source.camera.height() * options.scale))));
-  info.fps = options.fps;
+  info.fps = options.fps / options.frame_step;
   info.frame_count = count;
   info.depth_unit_mm = options.depth_unit_mm;
   if (source.right) info.stereo = StereoInfo{source.baseline_mm, info.camera};
@@ -461,6 +471,7 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
                      {"format", options.format},
                      {"source", fs::absolute(options.input).string()}};
   info.provenance.update(source.provenance);
+  if (options.frame_step != 1) info.provenance["frame_step"] = options.frame_step;  // frame i was the dataset's i·step
   if (options.scale != 1.0) {
     info.provenance["scale"] = options.scale;
     info.provenance["source_camera"] = source.camera;

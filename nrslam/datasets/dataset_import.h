@@ -40,6 +40,9 @@ struct ImportOptions {
   std::filesystem::path mask;
   double fps = 30.0;                   // frames per second (timestamps of the ground truth)
   int max_frames = 0;                  // import at most this many frames; 0 = all
+  // Keep every frame_step-th frame of the dataset (2 turns a 50 fps video into 25 fps); the
+  // sequence's fps is fps / frame_step. max_frames counts the frames kept.
+  int frame_step = 1;
   double depth_unit_mm = 0.01;         // resolution of the written 16-bit depth, mm
   // Resize factor for every image, depth map and the calibration (which describes the dataset's
   // own images), in (0, 4]: 0.5 halves Endomapper's 1440×1080 to 720×540, as the reference does.
