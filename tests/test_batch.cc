@@ -156,7 +156,9 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   EXPECT_EQ(manifest.sequences[2].simulate, (std::vector<std::string>{lens, "frames=9"}));
   // A raw stereo recording: its three files relative to the manifest, a flag given bare (the
   // options in the keys' alphabetical order).
-  const auto raw = [&](const char* file) { return (std::filesystem::absolute(folder) / "lists" / "raw" / file).lexically_normal().string(); };
+  const auto raw = [&](const char* file) {
+    return (std::filesystem::absolute(folder) / "lists" / "raw" / file).lexically_normal().string();
+  };
   EXPECT_EQ(manifest.sequences[3].import,
             (std::vector<std::string>{"--calibration", raw("stereo.yml"), "--format", "stereo", "--in", raw("left.avi"),
                                       "--rectified-size", "720x576", "--right", raw("right.avi"), "--stereo-depth"}));

@@ -134,7 +134,9 @@ TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
   ImportDataset(options, UniqueTempFolder("hamlyn_stereo"));
   const SequenceReader stereo(UniqueTempFolder("hamlyn_stereo"));
   EXPECT_TRUE(stereo.has_depth());
-  EXPECT_EQ(stereo.info().provenance.at("depth").at("generator").get<std::string>().rfind("nrslam_import --stereo-depth", 0), 0u);
+  EXPECT_EQ(
+      stereo.info().provenance.at("depth").at("generator").get<std::string>().rfind("nrslam_import --stereo-depth", 0),
+      0u);
   fs::remove_all(UniqueTempFolder("hamlyn_stereo"));
   fs::remove_all(in / "image02");
   EXPECT_NE(ImportError(options, out).find("--stereo-depth needs the right camera's images"), std::string::npos);

@@ -75,10 +75,10 @@ StereoCalibration Rig() {
   StereoCalibration rig;
   rig.left = Camera::OpenCv(kWidth, kHeight, 300, 302, 161.0, 118.5, {-0.25, 0.08, 0.001, -0.0005, -0.01});
   rig.right = Camera::OpenCv(kWidth, kHeight, 305, 306, 157.5, 122.0, {-0.22, 0.06, -0.0008, 0.0004, 0.0});
-  const Eigen::Matrix3d toe_in = (Eigen::AngleAxisd(0.035, Eigen::Vector3d::UnitY()) *
-                                  Eigen::AngleAxisd(0.012, Eigen::Vector3d::UnitX()) *
-                                  Eigen::AngleAxisd(-0.008, Eigen::Vector3d::UnitZ()))
-                                     .toRotationMatrix();
+  const Eigen::Matrix3d toe_in =
+      (Eigen::AngleAxisd(0.035, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(0.012, Eigen::Vector3d::UnitX()) *
+       Eigen::AngleAxisd(-0.008, Eigen::Vector3d::UnitZ()))
+          .toRotationMatrix();
   rig.right_from_left = Rigid3(Eigen::Quaterniond(toe_in), Eigen::Vector3d(-5.2, 0.15, 0.1));
   return rig;
 }
@@ -210,8 +210,8 @@ TEST(StereoRectification, ARawDistortedPairGivesThePlanesTrueDepth) {
     double coverage = 0;
     const cv::Mat depth = sequence.ReadDepthMm(i);  // --stereo-depth's, from the rectified pair
     const double median = MedianDepthError(depth, info.camera, rectified_from_left, &coverage);
-    std::printf("frame %d: rectified pair, stereo depth on %.1f %% of the pixels, median |error| %.3f mm, f %.1f px\n", i,
-                100 * coverage, median, info.camera.fx());
+    std::printf("frame %d: rectified pair, stereo depth on %.1f %% of the pixels, median |error| %.3f mm, f %.1f px\n",
+                i, 100 * coverage, median, info.camera.fx());
     // Measured: 92 % of the pixels, median error 0.31 mm at 45–75 mm (disparities of 20–35 px).
     // That is semi-global matching's own error: an ideal rectified pair of the same plane, rendered
     // directly with the rectified camera, measured 0.33 mm.
@@ -224,17 +224,18 @@ TEST(StereoRectification, ARawDistortedPairGivesThePlanesTrueDepth) {
   const SequenceInfo half = ImportDataset(options, folder / "half");
   EXPECT_EQ(half.camera.width(), kWidth / 2);
   double half_coverage = 0;
-  const double half_median =
-      MedianDepthError(SequenceReader(folder / "half").ReadDepthMm(0), half.camera, rectified_from_left, &half_coverage);
-  std::printf("halved: stereo depth on %.1f %% of the pixels, median |error| %.3f mm\n", 100 * half_coverage, half_median);
+  const double half_median = MedianDepthError(SequenceReader(folder / "half").ReadDepthMm(0), half.camera,
+                                              rectified_from_left, &half_coverage);
+  std::printf("halved: stereo depth on %.1f %% of the pixels, median |error| %.3f mm\n", 100 * half_coverage,
+              half_median);
   EXPECT_GT(half_coverage, 0.7);
   EXPECT_LT(half_median, 0.5);
   // The control: the raw pair read as if it were rectified (left intrinsics, |T|) is far off,
   // so the figures above are the rectification's.
   double raw_coverage = 0;
-  const cv::Mat raw_depth = StereoDepthMm(cv::imread((folder / "left" / "0.png").string()),
-                                          cv::imread((folder / "right" / "0.png").string()), rig.left.fx(),
-                                          rig.right_from_left.translation.norm(), StereoDepthOptions{});
+  const cv::Mat raw_depth =
+      StereoDepthMm(cv::imread((folder / "left" / "0.png").string()), cv::imread((folder / "right" / "0.png").string()),
+                    rig.left.fx(), rig.right_from_left.translation.norm(), StereoDepthOptions{});
   const double raw_median = MedianDepthError(raw_depth, rig.left, Eigen::Matrix3d::Identity(), &raw_coverage);
   std::printf("control: the raw pair as if rectified, depth on %.1f %%, median |error| %.3f mm\n", 100 * raw_coverage,
               raw_median);
@@ -264,7 +265,8 @@ TEST(StereoRectification, PackedLayoutsAndAVideoGiveTheSameImages) {
     EXPECT_EQ(cv::norm(two.ReadRight(i), packed.ReadRight(i), cv::NORM_INF), 0.0);
     // The video is JPEG-compressed: close to the PNGs' frame, and far from the next frame's.
     const double same = cv::norm(two.ReadRgb(i), video.ReadRgb(i), cv::NORM_L1) / two.ReadRgb(i).total();
-    const double next = cv::norm(two.ReadRgb((i + 1) % kFrames), video.ReadRgb(i), cv::NORM_L1) / two.ReadRgb(i).total();
+    const double next =
+        cv::norm(two.ReadRgb((i + 1) % kFrames), video.ReadRgb(i), cv::NORM_L1) / two.ReadRgb(i).total();
     const double right = cv::norm(two.ReadRight(i), video.ReadRight(i), cv::NORM_L1) / two.ReadRight(i).total();
     EXPECT_LT(same, 10.0);
     EXPECT_LT(right, 10.0);
@@ -317,8 +319,9 @@ TEST(StereoRectification, KalibrAndRosCalibrationsGiveTheirRig) {
   const auto kalibr_camera = [](const Camera& camera) {
     const std::vector<double>& p = camera.params();
     return "  camera_model: pinhole\n  distortion_model: radtan\n  distortion_coeffs: " +
-           FlowList(Eigen::Vector4d(p[4], p[5], p[6], p[7]).transpose()) + "\n  intrinsics: " +
-           FlowList(Eigen::Vector4d(p[0], p[1], p[2], p[3]).transpose()) + "\n  resolution: [320, 240]\n  rostopic: /cam/image_raw\n";
+           FlowList(Eigen::Vector4d(p[4], p[5], p[6], p[7]).transpose()) +
+           "\n  intrinsics: " + FlowList(Eigen::Vector4d(p[0], p[1], p[2], p[3]).transpose()) +
+           "\n  resolution: [320, 240]\n  rostopic: /cam/image_raw\n";
   };
   {
     // T_cn_cnm1 in metres, one row per line.
@@ -333,24 +336,32 @@ TEST(StereoRectification, KalibrAndRosCalibrationsGiveTheirRig) {
 
   cv::Mat r1, r2, p1, p2, q;
   const auto k = [](const Camera& c) { return cv::Matx33d(c.fx(), 0, c.cx(), 0, c.fy(), c.cy(), 0, 0, 1); };
-  const auto d = [](const Camera& c) { return cv::Mat(std::vector<double>(c.params().begin() + 4, c.params().begin() + 9), true); };
+  const auto d = [](const Camera& c) {
+    return cv::Mat(std::vector<double>(c.params().begin() + 4, c.params().begin() + 9), true);
+  };
   const Eigen::Matrix3d rotation = rig.right_from_left.rotation.toRotationMatrix();
   cv::Matx33d r;
   for (int i = 0; i < 9; ++i) r.val[i] = rotation(i / 3, i % 3);
   const Eigen::Vector3d& t = rig.right_from_left.translation;
   cv::stereoRectify(k(rig.left), d(rig.left), k(rig.right), d(rig.right), cv::Size(kWidth, kHeight), r,
                     cv::Vec3d(t.x(), t.y(), t.z()) / 1000.0, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY, 0.3);
-  const auto camera_info = [&](const fs::path& file, const Camera& camera, const cv::Mat& rectification, const cv::Mat& projection) {
+  const auto camera_info = [&](const fs::path& file, const Camera& camera, const cv::Mat& rectification,
+                               const cv::Mat& projection) {
     const auto eigen = [](const cv::Mat& m) {
       Eigen::MatrixXd e(m.rows, m.cols);
-      for (int i = 0; i < m.rows; ++i) for (int j = 0; j < m.cols; ++j) e(i, j) = m.at<double>(i, j);
+      for (int i = 0; i < m.rows; ++i)
+        for (int j = 0; j < m.cols; ++j) e(i, j) = m.at<double>(i, j);
       return e;
     };
     const std::vector<double>& p = camera.params();
-    std::ofstream(file) << "image_width: 320\nimage_height: 240\ncamera_name: narrow_stereo\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: "
-                        << FlowList(eigen(cv::Mat(k(camera)))) << "\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: "
-                        << FlowList(Eigen::Matrix<double, 1, 5>(p[4], p[5], p[6], p[7], p[8])) << "\nrectification_matrix:\n  rows: 3\n  cols: 3\n  data: "
-                        << FlowList(eigen(rectification)) << "\nprojection_matrix:\n  rows: 3\n  cols: 4\n  data: " << FlowList(eigen(projection)) << "\n";
+    std::ofstream(file) << "image_width: 320\nimage_height: 240\ncamera_name: narrow_stereo\ncamera_matrix:\n  rows: "
+                           "3\n  cols: 3\n  data: "
+                        << FlowList(eigen(cv::Mat(k(camera))))
+                        << "\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: "
+                        << FlowList(Eigen::Matrix<double, 1, 5>(p[4], p[5], p[6], p[7], p[8]))
+                        << "\nrectification_matrix:\n  rows: 3\n  cols: 3\n  data: " << FlowList(eigen(rectification))
+                        << "\nprojection_matrix:\n  rows: 3\n  cols: 4\n  data: " << FlowList(eigen(projection))
+                        << "\n";
   };
   camera_info(folder / "left.yaml", rig.left, r1, p1);
   camera_info(folder / "right.yaml", rig.right, r2, p2);
@@ -360,7 +371,9 @@ TEST(StereoRectification, KalibrAndRosCalibrationsGiveTheirRig) {
   EXPECT_EQ(ros.right.params(), rig.right.params());
 
   // One camera_info alone is not a pair.
-  EXPECT_NE(ErrorMessage([&] { ReadStereoCalibration({folder / "left.yaml"}, std::nullopt, 0.0); }).find("not a stereo calibration"),
+  EXPECT_NE(ErrorMessage([&] {
+              ReadStereoCalibration({folder / "left.yaml"}, std::nullopt, 0.0);
+            }).find("not a stereo calibration"),
             std::string::npos);
   fs::remove_all(folder);
 }
@@ -400,7 +413,8 @@ TEST(StereoRectification, RefusesWhatCannotBeASideBySidePair) {
             std::string::npos);
   options.input = folder / "left";
   options.right = folder / "both";
-  EXPECT_NE(StereoError(options, folder / "out").find("right frame 0 is 640x240 but the left frames and the calibration are 320x240"),
+  EXPECT_NE(StereoError(options, folder / "out")
+                .find("right frame 0 is 640x240 but the left frames and the calibration are 320x240"),
             std::string::npos);
   options = StereoImport(folder);
   fs::remove(folder / "right" / "2.png");

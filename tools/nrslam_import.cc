@@ -16,9 +16,13 @@ int main(int argc, char** argv) {
   nrslam::ImportOptions options;
   std::string out;
   app.add_option("--format", options.format, "endomapper-sim, hamlyn, c3vd, images or stereo")->required();
-  app.add_option("--in", options.input, "the dataset's folder (or a video file for --format images and stereo)")->required();
+  app.add_option("--in", options.input, "the dataset's folder (or a video file for --format images and stereo)")
+      ->required();
   app.add_option("--out", out, "sequence folder to write")->required();
-  app.add_option("--calibration", options.calibration, "camera JSON (as in sequence.json), OCamCalib's calib_results.txt or an OpenCV / ROS calibration (.yml, .yaml, .xml); c3vd and images need one; stereo needs the pair's stereo calibration (OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain, or ROS camera_info with --second-calibration)");
+  app.add_option("--calibration", options.calibration,
+                 "camera JSON (as in sequence.json), OCamCalib's calib_results.txt or an OpenCV / ROS calibration "
+                 "(.yml, .yaml, .xml); c3vd and images need one; stereo needs the pair's stereo calibration (OpenCV's "
+                 "M1 D1 M2 D2 R T, Kalibr's camchain, or ROS camera_info with --second-calibration)");
   app.add_option("--mask", options.mask,
                  "fixed validity mask of the images (non-zero = usable), e.g. the black border of an endoscope's image");
   app.add_option("--fps", options.fps, "the dataset's frames per second")->capture_default_str();
@@ -31,21 +35,26 @@ int main(int argc, char** argv) {
                  "resize every image, depth map and the calibration by this factor, in (0, 4] (0.5 halves 1440x1080 to 720x540)")
       ->capture_default_str();
   app.add_option("--right", options.right, "stereo: the right camera's images (folder or video)");
-  app.add_option("--stereo-layout", options.stereo_layout,
-                 "stereo: both views in each input image, side-by-side (left half = left camera) or top-bottom (top = left)");
+  app.add_option(
+      "--stereo-layout", options.stereo_layout,
+      "stereo: both views in each input image, side-by-side (left half = left camera) or top-bottom (top = left)");
   app.add_option("--second-calibration", options.second_calibration,
-                 "stereo: a second calibration file: R and T of OpenCV's stereo_calib extrinsics.yml, or the right camera's ROS camera_info");
+                 "stereo: a second calibration file: R and T of OpenCV's stereo_calib extrinsics.yml, or the right "
+                 "camera's ROS camera_info");
   app.add_option("--stereo-unit-mm", options.stereo_unit_mm,
-                 "stereo: mm per unit of the calibration's translation; 0 = the format's own (OpenCV's names: mm; Kalibr, ROS: metres)")
+                 "stereo: mm per unit of the calibration's translation; 0 = the format's own (OpenCV's names: mm; "
+                 "Kalibr, ROS: metres)")
       ->capture_default_str();
   std::string rectified_size;
-  app.add_option("--rectified-size", rectified_size,
-                 "stereo: rectified image size WxH (default: the calibration's, stretched to square pixels when they are not)");
+  app.add_option(
+      "--rectified-size", rectified_size,
+      "stereo: rectified image size WxH (default: the calibration's, stretched to square pixels when they are not)");
   app.add_option("--rectify-alpha", options.rectify_alpha,
                  "stereo: cv::stereoRectify's alpha in [0, 1] (0: only pixels both views see) or -1 (OpenCV's default)")
       ->capture_default_str();
   app.add_flag("--stereo-depth", options.stereo_depth,
-               "write depth from the rectified pairs (semi-global matching, as nrslam_stereo_gt): stereo, or hamlyn without depth01/");
+               "write depth from the rectified pairs (semi-global matching, as nrslam_stereo_gt): stereo, or hamlyn "
+               "without depth01/");
   app.add_option("--near", options.near, "endomapper-sim: near plane, scene units")->capture_default_str();
   app.add_option("--far", options.far, "endomapper-sim: far plane, scene units")->capture_default_str();
   app.add_option("--scene-unit-mm", options.scene_unit_mm, "endomapper-sim: mm per scene unit")->capture_default_str();
@@ -53,8 +62,8 @@ int main(int argc, char** argv) {
   try {
     if (!rectified_size.empty()) {
       char separator = 0, rest = 0;
-      if (std::sscanf(rectified_size.c_str(), "%d%c%d%c", &options.rectified_width, &separator, &options.rectified_height,
-                      &rest) != 3 ||
+      if (std::sscanf(rectified_size.c_str(), "%d%c%d%c", &options.rectified_width, &separator,
+                      &options.rectified_height, &rest) != 3 ||
           (separator != 'x' && separator != 'X') || options.rectified_width <= 0 || options.rectified_height <= 0) {
         throw nrslam::Error("--rectified-size: expected WIDTHxHEIGHT, e.g. 720x576, got '" + rectified_size + "'");
       }

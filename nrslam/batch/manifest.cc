@@ -100,11 +100,14 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
     for (const auto& [key, value] : import.items()) {
       Require(kImportKeys.count(key) > 0, context, "import: unknown key '" + key + "'");
       std::string text = value.is_string() ? value.get<std::string>() : value.dump();
-      if (key == "path" || key == "calibration" || key == "mask" || key == "right" || key == "second_calibration") text = FromManifest(text, folder).string();
+      if (key == "path" || key == "calibration" || key == "mask" || key == "right" || key == "second_calibration") {
+        text = FromManifest(text, folder).string();
+      }
       std::string option = key == "path" ? "in" : key;
       std::replace(option.begin(), option.end(), '_', '-');
       Require(value.is_boolean() == (key == "stereo_depth"), context,
-              "import: \"" + key + (key == "stereo_depth" ? "\" must be true or false" : "\" takes a value, not true or false"));
+              "import: \"" + key +
+                  (key == "stereo_depth" ? "\" must be true or false" : "\" takes a value, not true or false"));
       if (value.is_boolean()) {  // a flag: given when true
         if (value.get<bool>()) sequence.import.push_back("--" + option);
         continue;

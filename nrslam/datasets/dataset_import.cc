@@ -244,7 +244,7 @@ FrameSource C3vd(const ImportOptions& options) {
 }
 
 // The frames of an image folder (sorted by name) or a video file: their count and a reader,
-// which reads a video's frames in order.
+// which for a video only goes forward (frames skipped over are grabbed, not decoded).
 struct FrameStream {
   int count = 0;
   std::function<cv::Mat(int)> read;  // BGR
@@ -268,10 +268,15 @@ FrameStream OpenFrames(const ImportOptions& options, const fs::path& input) {
   auto video = std::make_shared<cv::VideoCapture>(input.string());
   auto next = std::make_shared<int>(0);  // the frame the video decodes next
   stream.read = [&options, video, next, input](int i) {
-    if (i < *next) Fail(options, "frame " + std::to_string(i) + " of " + input.string() + " asked for after frame " + std::to_string(*next));
+    if (i < *next) {
+      Fail(options,
+           "frame " + std::to_string(i) + " of " + input.string() + " asked for after frame " + std::to_string(*next));
+    }
     cv::Mat frame;
     while (*next < i && video->grab()) ++*next;  // frames skipped (--frame-step) are not decoded
-    if (*next != i || !video->read(frame)) Fail(options, "cannot decode frame " + std::to_string(i) + " of " + input.string());
+    if (*next != i || !video->read(frame)) {
+      Fail(options, "cannot decode frame " + std::to_string(i) + " of " + input.string());
+    }
     ++*next;
     return frame;
   };
@@ -292,8 +297,9 @@ FrameSource Images(const ImportOptions& options) {
 // hold both (side by side, or the left above the right), rectified with the pair's calibration.
 FrameSource Stereo(const ImportOptions& options) {
   if (options.calibration.empty()) {
-    Fail(options, "needs --calibration: the pair's stereo calibration (OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain, or "
-                  "the left camera's ROS camera_info with the right one's as --second-calibration)");
+    Fail(options,
+         "needs --calibration: the pair's stereo calibration (OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain, or "
+         "the left camera's ROS camera_info with the right one's as --second-calibration)");
   }
   const bool packed = !options.stereo_layout.empty();
   if (packed == !options.right.empty()) {
@@ -302,18 +308,19 @@ FrameSource Stereo(const ImportOptions& options) {
   const FrameStream left = OpenFrames(options, options.input);
   const FrameStream right = packed ? left : OpenFrames(options, options.right);
   if (right.count != left.count) {
-    Fail(options, "the right camera has " + std::to_string(right.count) + " frames, the left " +
-                      std::to_string(left.count));
+    Fail(options,
+         "the right camera has " + std::to_string(right.count) + " frames, the left " + std::to_string(left.count));
   }
   // One image holding both views splits in halves; the calibration is of one view.
   const bool side_by_side = options.stereo_layout == "side-by-side";
   const auto half = [&options, side_by_side](const cv::Mat& both, int index, int i) {
     const int width = side_by_side ? both.cols / 2 : both.cols, height = side_by_side ? both.rows : both.rows / 2;
     if ((side_by_side ? both.cols : both.rows) % 2 != 0) {
-      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(both.cols) + "x" + std::to_string(both.rows) +
-                        ", which does not split into two equal views");
+      Fail(options, "frame " + std::to_string(i) + " is " + std::to_string(both.cols) + "x" +
+                        std::to_string(both.rows) + ", which does not split into two equal views");
     }
-    const cv::Rect view = side_by_side ? cv::Rect(index * width, 0, width, height) : cv::Rect(0, index * height, width, height);
+    const cv::Rect view =
+        side_by_side ? cv::Rect(index * width, 0, width, height) : cv::Rect(0, index * height, width, height);
     return both(view).clone();
   };
   // The left stream's last decoded frame: a video decodes in order, and a packed frame holds
@@ -328,7 +335,8 @@ FrameSource Stereo(const ImportOptions& options) {
   if (!options.second_calibration.empty()) calibration_files.push_back(options.second_calibration);
   StereoCalibration calibration;
   try {
-    calibration = ReadStereoCalibration(calibration_files, std::make_pair(first.cols, first.rows), options.stereo_unit_mm);
+    calibration =
+        ReadStereoCalibration(calibration_files, std::make_pair(first.cols, first.rows), options.stereo_unit_mm);
   } catch (const Error& e) {
     Fail(options, e.what());
   }
@@ -359,9 +367,12 @@ FrameSource Stereo(const ImportOptions& options) {
       {"alpha", options.rectify_alpha},
       {"raw_left_camera", calibration.left},
       {"raw_right_camera", calibration.right},
-      {"rectified_from_raw_left", {{r1(0, 0), r1(0, 1), r1(0, 2)}, {r1(1, 0), r1(1, 1), r1(1, 2)}, {r1(2, 0), r1(2, 1), r1(2, 2)}}}};
+      {"rectified_from_raw_left",
+       {{r1(0, 0), r1(0, 1), r1(0, 2)}, {r1(1, 0), r1(1, 1), r1(1, 2)}, {r1(2, 0), r1(2, 1), r1(2, 2)}}}};
   const auto raw = [=, &options](bool right_view, int i) {
-    const cv::Mat image = packed ? half(left_frame(i), right_view ? 1 : 0, i) : right_view ? right.read(i) : left_frame(i);
+    const cv::Mat image = packed       ? half(left_frame(i), right_view ? 1 : 0, i)
+                          : right_view ? right.read(i)
+                                       : left_frame(i);
     if (image.cols != calibration.left.width() || image.rows != calibration.left.height()) {
       Fail(options, std::string(right_view ? "right" : "left") + " frame " + std::to_string(i) + " is " +
                         std::to_string(image.cols) + "x" + std::to_string(image.rows) + " but the " +
@@ -393,8 +404,9 @@ void WriteFrames(const ImportOptions& options, const FrameSource& source, int co
     const int from = i * options.frame_step;  // the dataset's frame that becomes frame i
     const cv::Mat rgb = source.rgb(from);
     if (rgb.size() != size) {
-      Fail(options, "frame " + std::to_string(from) + " is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
-                        " but the camera is " + std::to_string(size.width) + "x" + std::to_string(size.height));
+      Fail(options, "frame " + std::to_string(from) + " is " + std::to_string(rgb.cols) + "x" +
+                        std::to_string(rgb.rows) + " but the camera is " + std::to_string(size.width) + "x" +
+                        std::to_string(size.height));
     }
     writer.WriteRgb(i, Resized(rgb, written, false));
     const cv::Mat right = source.right ? source.right(from) : cv::Mat();
@@ -402,9 +414,12 @@ void WriteFrames(const ImportOptions& options, const FrameSource& source, int co
     if (source.depth_mm || options.stereo_depth) {
       // Stereo depth is matched at the source's size, before any --scale: ground truth as fine as
       // the recording gives (halved first, the test's plane came out 2.3× less accurate).
-      const cv::Mat depth = source.depth_mm ? source.depth_mm(from)
-                                            : StereoDepthMm(rgb, right, source.camera.fx(), source.baseline_mm, StereoDepthOptions{});
-      if (depth.size() != size) Fail(options, "depth of frame " + std::to_string(from) + " has another size than the image");
+      const cv::Mat depth =
+          source.depth_mm ? source.depth_mm(from)
+                          : StereoDepthMm(rgb, right, source.camera.fx(), source.baseline_mm, StereoDepthOptions{});
+      if (depth.size() != size) {
+        Fail(options, "depth of frame " + std::to_string(from) + " has another size than the image");
+      }
       writer.WriteDepthMm(i, Resized(depth, written, true));
     }
   }
@@ -433,15 +448,20 @@ void ImportOptions::Check() const {
     throw Error("import options: need fps > 0, max_frames >= 0, depth_unit_mm > 0, 0 < near < far, scene_unit_mm > 0");
   }
   if (!(scale > 0 && scale <= 4)) throw Error("import options: scale must be in (0, 4], got " + std::to_string(scale));
-  const bool stereo_option = !right.empty() || !second_calibration.empty() || !stereo_layout.empty() || rectified_width != 0 ||
-                             rectified_height != 0 || rectify_alpha != 0.0 || stereo_unit_mm != 0.0;
+  const bool stereo_option = !right.empty() || !second_calibration.empty() || !stereo_layout.empty() ||
+                             rectified_width != 0 || rectified_height != 0 || rectify_alpha != 0.0 ||
+                             stereo_unit_mm != 0.0;
   if (stereo_option && format != "stereo") {
-    throw Error("import options: the right images, stereo layout, second calibration and rectification apply to --format stereo only");
+    throw Error(
+        "import options: the right images, stereo layout, second calibration and rectification apply to --format "
+        "stereo only");
   }
   if (!stereo_layout.empty() && stereo_layout != "side-by-side" && stereo_layout != "top-bottom") {
     throw Error("import options: stereo layout must be side-by-side or top-bottom, got '" + stereo_layout + "'");
   }
-  if (stereo_unit_mm < 0) throw Error("import options: stereo_unit_mm must be > 0 (or 0: the calibration format's own)");
+  if (stereo_unit_mm < 0) {
+    throw Error("import options: stereo_unit_mm must be > 0 (or 0: the calibration format's own)");
+  }
   StereoRectificationOptions{rectified_width, rectified_height, rectify_alpha}.Check();
 }
 

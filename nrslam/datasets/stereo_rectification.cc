@@ -21,10 +21,14 @@ cv::Matx33d CameraMatrix(const Camera& camera) {
 cv::Mat DistortionCoefficients(const Camera& camera) {
   const std::vector<double>& p = camera.params();
   switch (camera.model()) {
-    case CameraModelId::kPinhole: return cv::Mat::zeros(1, 5, CV_64F);
-    case CameraModelId::kOpenCv: return cv::Mat(std::vector<double>(p.begin() + 4, p.begin() + 12), true).reshape(1, 1);
-    case CameraModelId::kKannalaBrandt: return cv::Mat(std::vector<double>(p.begin() + 4, p.begin() + 8), true).reshape(1, 1);
-    case CameraModelId::kOcam: break;
+    case CameraModelId::kPinhole:
+      return cv::Mat::zeros(1, 5, CV_64F);
+    case CameraModelId::kOpenCv:
+      return cv::Mat(std::vector<double>(p.begin() + 4, p.begin() + 12), true).reshape(1, 1);
+    case CameraModelId::kKannalaBrandt:
+      return cv::Mat(std::vector<double>(p.begin() + 4, p.begin() + 8), true).reshape(1, 1);
+    case CameraModelId::kOcam:
+      break;
   }
   throw Error("stereo rectification: OpenCV cannot rectify the " + camera.model_name() +
               " model; calibrate the pair with OpenCV's radial-tangential or fisheye model");
@@ -88,8 +92,8 @@ StereoRectifier::StereoRectifier(const StereoCalibration& calibration, const Ste
   // vertically (the offset is in P2's second row); the sequence format stores side-by-side views.
   const double horizontal = p2.at<double>(0, 3), vertical = p2.at<double>(1, 3);
   if (std::abs(vertical) > std::abs(horizontal)) {
-    throw Error("stereo rectification: the second camera is above or below the first (T = " +
-                std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
+    throw Error("stereo rectification: the second camera is above or below the first (T = " + std::to_string(t[0]) +
+                ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
                 "), and the sequence format stores a side-by-side pair");
   }
   if (horizontal > 0.0) {
@@ -104,7 +108,8 @@ StereoRectifier::StereoRectifier(const StereoCalibration& calibration, const Ste
     for (int j = 0; j < 3; ++j) rectified_from_left_(i, j) = r1.at<double>(i, j);
   }
   if (fisheye) {
-    cv::fisheye::initUndistortRectifyMap(k1, left_distortion, r1, p1, size, CV_16SC2, left_maps_.first, left_maps_.second);
+    cv::fisheye::initUndistortRectifyMap(k1, left_distortion, r1, p1, size, CV_16SC2, left_maps_.first,
+                                         left_maps_.second);
     cv::fisheye::initUndistortRectifyMap(k2, right_distortion, r2, p2, size, CV_16SC2, right_maps_.first,
                                          right_maps_.second);
   } else {

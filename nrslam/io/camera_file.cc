@@ -199,7 +199,9 @@ Camera ReadOpenCvCalibration(const std::filesystem::path& file) {
 namespace {
 
 Eigen::Matrix3d Rotation(const std::vector<double>& row_major, const std::string& key) {
-  if (row_major.size() != 9) throw Error("'" + key + "' must be a 3x3 rotation, has " + std::to_string(row_major.size()) + " numbers");
+  if (row_major.size() != 9) {
+    throw Error("'" + key + "' must be a 3x3 rotation, has " + std::to_string(row_major.size()) + " numbers");
+  }
   const Eigen::Matrix3d rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(row_major.data());
   if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3 || rotation.determinant() < 0) {
     throw Error("'" + key + "' is not a rotation");
@@ -209,8 +211,8 @@ Eigen::Matrix3d Rotation(const std::vector<double>& row_major, const std::string
 
 // OpenCV's names, from whichever file has each: OpenCV's stereo_calib sample writes the
 // intrinsics (M1 D1 M2 D2) and the extrinsics (R T) to two files.
-StereoCalibration OpenCvStereo(const std::vector<cv::FileStorage>& storages, std::optional<std::pair<int, int>> image_size,
-                               double translation_unit_mm) {
+StereoCalibration OpenCvStereo(const std::vector<cv::FileStorage>& storages,
+                               std::optional<std::pair<int, int>> image_size, double translation_unit_mm) {
   const auto holding = [&](const char* key) -> cv::FileNode {
     for (const cv::FileStorage& storage : storages) {
       if (!FirstEntry(storage.root(), {key}).first.empty()) return storage.root();
@@ -224,7 +226,8 @@ StereoCalibration OpenCvStereo(const std::vector<cv::FileStorage>& storages, std
   const Eigen::Matrix3d rotation = Rotation(EntryNumbers(holding("R")["R"], "R"), "R");
   const std::vector<double> t = EntryNumbers(holding("T")["T"], "T");
   if (t.size() != 3) throw Error("'T' must be 3 numbers, has " + std::to_string(t.size()));
-  stereo.right_from_left = Rigid3(Eigen::Quaterniond(rotation), Eigen::Vector3d(t[0], t[1], t[2]) * translation_unit_mm);
+  stereo.right_from_left =
+      Rigid3(Eigen::Quaterniond(rotation), Eigen::Vector3d(t[0], t[1], t[2]) * translation_unit_mm);
   return stereo;
 }
 
@@ -236,15 +239,19 @@ Camera KalibrCamera(const cv::FileNode& node, const std::string& name) {
   const std::vector<double> intrinsics = EntryNumbers(node["intrinsics"], name + ".intrinsics");
   if (intrinsics.size() != 4) throw Error(name + ".intrinsics must be [fu, fv, pu, pv]");
   const std::pair<int, int> size = CalibrationImageSize(node, std::nullopt);
-  const std::string distortion = node["distortion_model"].isString() ? static_cast<std::string>(node["distortion_model"]) : "none";
-  const std::vector<double> k =
-      node["distortion_coeffs"].empty() ? std::vector<double>() : EntryNumbers(node["distortion_coeffs"], name + ".distortion_coeffs");
+  const std::string distortion =
+      node["distortion_model"].isString() ? static_cast<std::string>(node["distortion_model"]) : "none";
+  const std::vector<double> k = node["distortion_coeffs"].empty()
+                                    ? std::vector<double>()
+                                    : EntryNumbers(node["distortion_coeffs"], name + ".distortion_coeffs");
   const auto [fx, fy, cx, cy] = std::array<double, 4>{intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3]};
   const bool undistorted = std::all_of(k.begin(), k.end(), [](double d) { return d == 0.0; });
   if (distortion == "none" || undistorted) return Camera::Pinhole(size.first, size.second, fx, fy, cx, cy);
   if (k.size() != 4) throw Error(name + ".distortion_coeffs must hold 4 numbers");
   if (distortion == "radtan") return Camera::OpenCv(size.first, size.second, fx, fy, cx, cy, k);
-  if (distortion == "equidistant") return Camera::KannalaBrandt(size.first, size.second, fx, fy, cx, cy, Eigen::Vector4d(k[0], k[1], k[2], k[3]));
+  if (distortion == "equidistant") {
+    return Camera::KannalaBrandt(size.first, size.second, fx, fy, cx, cy, Eigen::Vector4d(k[0], k[1], k[2], k[3]));
+  }
   throw Error(name + ": distortion_model '" + distortion + "' (known: radtan, equidistant, none)");
 }
 
@@ -259,7 +266,8 @@ StereoCalibration KalibrStereo(const cv::FileStorage& storage, double translatio
     matrix.insert(matrix.end(), numbers.begin(), numbers.end());
   }
   if (matrix.size() != 16) throw Error("cam1.T_cn_cnm1 must be a 4x4 matrix");
-  const std::vector<double> rotation = {matrix[0], matrix[1], matrix[2], matrix[4], matrix[5], matrix[6], matrix[8], matrix[9], matrix[10]};
+  const std::vector<double> rotation = {matrix[0], matrix[1], matrix[2], matrix[4], matrix[5],
+                                        matrix[6], matrix[8], matrix[9], matrix[10]};
   stereo.right_from_left = Rigid3(Eigen::Quaterniond(Rotation(rotation, "cam1.T_cn_cnm1")),
                                   Eigen::Vector3d(matrix[3], matrix[7], matrix[11]) * translation_unit_mm);
   return stereo;
@@ -276,12 +284,15 @@ StereoCalibration RosStereo(const cv::FileStorage& left, const cv::FileStorage& 
   StereoCalibration stereo;
   stereo.left = camera(left);
   stereo.right = camera(right);
-  const Eigen::Matrix3d r_left = Rotation(EntryNumbers(left["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
-  const Eigen::Matrix3d r_right = Rotation(EntryNumbers(right["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
+  const Eigen::Matrix3d r_left =
+      Rotation(EntryNumbers(left["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
+  const Eigen::Matrix3d r_right =
+      Rotation(EntryNumbers(right["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
   const std::vector<double> p = EntryNumbers(right["projection_matrix"], "projection_matrix");
   if (p.size() != 12) throw Error("the right camera's projection_matrix must be 3x4");
   const Eigen::Vector3d offset(p[3] / p[0], p[7] / p[5], 0.0);
-  stereo.right_from_left = Rigid3(Eigen::Quaterniond(r_right.transpose() * r_left), r_right.transpose() * offset * translation_unit_mm);
+  stereo.right_from_left =
+      Rigid3(Eigen::Quaterniond(r_right.transpose() * r_left), r_right.transpose() * offset * translation_unit_mm);
   return stereo;
 }
 
@@ -296,10 +307,14 @@ StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>
     if (translation_unit_mm < 0) throw Error("the unit of the translation must be > 0 mm (0: the format's own)");
     std::vector<cv::FileStorage> storages;
     for (const std::filesystem::path& file : files) storages.push_back(OpenCalibrationStorage(file));
-    const auto has = [](const cv::FileStorage& storage, const char* key) { return !FirstEntry(storage.root(), {key}).first.empty(); };
-    const bool opencv = std::any_of(storages.begin(), storages.end(), [&](const cv::FileStorage& s) { return has(s, "M1"); });
+    const auto has = [](const cv::FileStorage& storage, const char* key) {
+      return !FirstEntry(storage.root(), {key}).first.empty();
+    };
+    const bool opencv =
+        std::any_of(storages.begin(), storages.end(), [&](const cv::FileStorage& s) { return has(s, "M1"); });
     const bool kalibr = has(storages[0], "cam0") && has(storages[0], "cam1");
-    const bool ros = storages.size() == 2 && has(storages[0], "projection_matrix") && has(storages[1], "projection_matrix");
+    const bool ros =
+        storages.size() == 2 && has(storages[0], "projection_matrix") && has(storages[1], "projection_matrix");
     // The formats' own units: OpenCV's files carry the unit their calibration target was
     // measured in (mm for SCARED); Kalibr and ROS use metres.
     const double unit = translation_unit_mm > 0 ? translation_unit_mm : opencv ? 1.0 : 1000.0;
@@ -311,8 +326,9 @@ StereoCalibration ReadStereoCalibration(const std::vector<std::filesystem::path>
     } else if (ros) {
       stereo = RosStereo(storages[0], storages[1], unit);
     } else {
-      throw Error("not a stereo calibration: expected OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain (cam0, cam1) or two "
-                  "ROS camera_info files (left, right)");
+      throw Error(
+          "not a stereo calibration: expected OpenCV's M1 D1 M2 D2 R T, Kalibr's camchain (cam0, cam1) or two "
+          "ROS camera_info files (left, right)");
     }
     stereo.left.Check();
     stereo.right.Check();
