@@ -137,7 +137,8 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
       {"name": "f", "path": "../data/f", "rigid": true, "first_frame": 3, "camera": "cams/f.json"},
       {"name": "l", "preset": "sim-1", "simulate": {"camera.calibration": "lenses/l.yml"}},
       {"name": "st", "import": {"format": "stereo", "path": "raw/left.avi", "right": "raw/right.avi",
-                                "calibration": "raw/stereo.yml", "rectified_size": "720x576", "stereo_depth": true}}
+                                "calibration": "raw/stereo.yml", "rectified_size": "720x576", "stereo_depth": true,
+                                "stereo_set": {"min_depth_mm": 20}}}
     ]})"));
   ASSERT_EQ(manifest.sequences.size(), 4u);
   const ManifestSequence& s = manifest.sequences[0];
@@ -161,7 +162,8 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   };
   EXPECT_EQ(manifest.sequences[3].import,
             (std::vector<std::string>{"--calibration", raw("stereo.yml"), "--format", "stereo", "--in", raw("left.avi"),
-                                      "--rectified-size", "720x576", "--right", raw("right.avi"), "--stereo-depth"}));
+                                      "--rectified-size", "720x576", "--right", raw("right.avi"), "--stereo-depth",
+                                      "--stereo-set", "min_depth_mm=20"}));
   std::filesystem::remove_all(folder);
 }
 

@@ -221,7 +221,9 @@ TEST(StereoRectification, ARawDistortedPairGivesThePlanesTrueDepth) {
   // Halved on import, the depth is still matched at the recording's size, then resized: as
   // accurate as unhalved (measured 0.31 mm; matched after halving, with half the disparity, 0.70).
   options.scale = 0.5;
+  options.stereo_depth_options.min_depth_mm = 30;  // the plane is 45–75 mm away: fewer disparities, same depth
   const SequenceInfo half = ImportDataset(options, folder / "half");
+  EXPECT_EQ(half.provenance.at("depth").at("options").at("min_depth_mm"), 30);
   EXPECT_EQ(half.camera.width(), kWidth / 2);
   double half_coverage = 0;
   const double half_median = MedianDepthError(SequenceReader(folder / "half").ReadDepthMm(0), half.camera,
@@ -400,6 +402,9 @@ TEST(StereoRectification, RefusesWhatCannotBeASideBySidePair) {
   ImportOptions options = StereoImport(folder);
   options.second_calibration.clear();
   EXPECT_NE(StereoError(options, folder / "out").find("no 'R'"), std::string::npos);
+  options = StereoImport(folder);
+  options.stereo_depth_options.block_size = 4;
+  EXPECT_NE(StereoError(options, folder / "out").find("an odd block_size"), std::string::npos);
   options = StereoImport(folder);
   options.stereo_layout = "side-by-side";
   EXPECT_NE(StereoError(options, folder / "out").find("either --right"), std::string::npos);

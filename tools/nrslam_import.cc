@@ -8,6 +8,7 @@
 
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 #include "nrslam/util/source_revision.h"
 
 int main(int argc, char** argv) {
@@ -55,11 +56,16 @@ int main(int argc, char** argv) {
   app.add_flag("--stereo-depth", options.stereo_depth,
                "write depth from the rectified pairs (semi-global matching, as nrslam_stereo_gt): stereo, or hamlyn "
                "without depth01/");
+  std::vector<std::string> stereo_settings;
+  app.add_option("--stereo-set", stereo_settings,
+                 "an option of --stereo-depth as nrslam_stereo_gt's --set, e.g. --stereo-set min_depth_mm=20 (fewer "
+                 "disparities to search)");
   app.add_option("--near", options.near, "endomapper-sim: near plane, scene units")->capture_default_str();
   app.add_option("--far", options.far, "endomapper-sim: far plane, scene units")->capture_default_str();
   app.add_option("--scene-unit-mm", options.scene_unit_mm, "endomapper-sim: mm per scene unit")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
+    options.stereo_depth_options = nrslam::WithAssignments(options.stereo_depth_options, stereo_settings);
     if (!rectified_size.empty()) {
       char separator = 0, rest = 0;
       if (std::sscanf(rectified_size.c_str(), "%d%c%d%c", &options.rectified_width, &separator,

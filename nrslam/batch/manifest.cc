@@ -25,7 +25,7 @@ const std::set<std::string> kExternalKeys = {"estimates", "trajectory", "stride"
 const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps", "max_frames", "frame_step",
                                            "depth_unit_mm", "near", "far", "scene_unit_mm", "scale", "mask",
                                            "right", "stereo_layout", "second_calibration", "stereo_unit_mm",
-                                           "rectified_size", "rectify_alpha", "stereo_depth"};
+                                           "rectified_size", "rectify_alpha", "stereo_depth", "stereo_set"};
 
 void Require(bool condition, const std::string& context, const std::string& message) {
   if (!condition) throw Error(context + ": " + message);
@@ -110,6 +110,14 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
                   (key == "stereo_depth" ? "\" must be true or false" : "\" takes a value, not true or false"));
       if (value.is_boolean()) {  // a flag: given when true
         if (value.get<bool>()) sequence.import.push_back("--" + option);
+        continue;
+      }
+      if (key == "stereo_set") {  // an object of stereo depth options, as "set" holds run options
+        Require(value.is_object(), context, "import: \"stereo_set\" must be an object, e.g. {\"min_depth_mm\": 20}");
+        for (const auto& [name, setting] : value.items()) {
+          sequence.import.push_back("--stereo-set");
+          sequence.import.push_back(Assignment(name, setting));
+        }
         continue;
       }
       sequence.import.push_back("--" + option);

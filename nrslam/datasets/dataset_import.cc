@@ -416,7 +416,7 @@ void WriteFrames(const ImportOptions& options, const FrameSource& source, int co
       // the recording gives (halved first, the test's plane came out 2.3× less accurate).
       const cv::Mat depth =
           source.depth_mm ? source.depth_mm(from)
-                          : StereoDepthMm(rgb, right, source.camera.fx(), source.baseline_mm, StereoDepthOptions{});
+                          : StereoDepthMm(rgb, right, source.camera.fx(), source.baseline_mm, options.stereo_depth_options);
       if (depth.size() != size) {
         Fail(options, "depth of frame " + std::to_string(from) + " has another size than the image");
       }
@@ -463,6 +463,7 @@ void ImportOptions::Check() const {
     throw Error("import options: stereo_unit_mm must be > 0 (or 0: the calibration format's own)");
   }
   StereoRectificationOptions{rectified_width, rectified_height, rectify_alpha}.Check();
+  stereo_depth_options.Check();
 }
 
 std::vector<std::string> ImportFormats() { return {"endomapper-sim", "hamlyn", "c3vd", "images", "stereo"}; }
@@ -512,7 +513,7 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
     if (!source.right) Fail(options, "--stereo-depth needs the right camera's images");
     if (source.depth_mm) Fail(options, "--stereo-depth: the dataset has depth of its own");
     info.provenance["depth"] = {{"generator", std::string("nrslam_import --stereo-depth ") + NRSLAM_VERSION},
-                                {"options", nlohmann::json(StereoDepthOptions{})}};
+                                {"options", nlohmann::json(options.stereo_depth_options)}};
   }
   const SequenceWriter writer(out, info, source.depth_mm || options.stereo_depth);
   try {

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "nrslam/datasets/stereo_depth.h"
 #include "nrslam/io/sequence_info.h"
 
 namespace nrslam {
@@ -65,9 +66,10 @@ struct ImportOptions {
   // (see StereoRectificationOptions).
   int rectified_width = 0, rectified_height = 0;
   double rectify_alpha = 0.0;
-  // Depth from the rectified pair (datasets/stereo_depth.h, default options), written as the
-  // sequence's depth as nrslam_stereo_gt would: for stereo recordings and Hamlyn without depth01/.
+  // Depth from the rectified pair (datasets/stereo_depth.h), written as the sequence's depth as
+  // nrslam_stereo_gt would: for stereo recordings and Hamlyn without depth01/.
   bool stereo_depth = false;
+  StereoDepthOptions stereo_depth_options;
   double near = 0.01, far = 4.0;       // endomapper-sim: depth-buffer planes, scene units
   double scene_unit_mm = 1000.0;       // endomapper-sim: mm per scene unit (Unity: metres)
   void Check() const;
