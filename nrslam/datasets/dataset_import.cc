@@ -16,6 +16,7 @@
 
 #include "nrslam/datasets/stereo_depth.h"
 #include "nrslam/datasets/stereo_rectification.h"
+#include "nrslam/geometry/rigid3.h"
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
@@ -234,7 +235,7 @@ FrameSource C3vd(const ImportOptions& options) {
       for (int c = 0; c < 4; ++c) matrix(r, c) = column_major ? v[c * 4 + r] : v[r * 4 + c];
     }
     const Eigen::Matrix3d rotation = matrix.topLeftCorner<3, 3>();
-    if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3) {
+    if (!IsRotation(rotation)) {
       Fail(options, "pose.txt line " + std::to_string(row) + ": not a rotation");
     }
     source.world_from_camera.emplace_back(Eigen::Quaterniond(rotation), matrix.topRightCorner<3, 1>());
@@ -321,7 +322,7 @@ FrameSource Stereo(const ImportOptions& options) {
     }
     const cv::Rect view =
         side_by_side ? cv::Rect(index * width, 0, width, height) : cv::Rect(0, index * height, width, height);
-    return both(view).clone();
+    return both(view);  // a view into the decoded frame, which stays alive while it is used
   };
   // The left stream's last decoded frame: a video decodes in order, and a packed frame holds
   // the right view too.

@@ -50,6 +50,12 @@ struct Rigid3 {
   }
 };
 
+// Whether a matrix read from a file is a rotation (orthonormal, not a reflection), to the
+// precision calibration and pose files are written with.
+inline bool IsRotation(const Eigen::Matrix3d& matrix, double tolerance = 1e-3) {
+  return (matrix.transpose() * matrix - Eigen::Matrix3d::Identity()).norm() <= tolerance && matrix.determinant() > 0;
+}
+
 // x_a = T_ab * x_b for a pose parameter block; templated for Ceres Jets.
 template <typename T>
 inline Eigen::Matrix<T, 3, 1> TransformPoint(const T* pose_params, const Eigen::Matrix<T, 3, 1>& x) {

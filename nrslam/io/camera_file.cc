@@ -203,7 +203,7 @@ Eigen::Matrix3d Rotation(const std::vector<double>& row_major, const std::string
     throw Error("'" + key + "' must be a 3x3 rotation, has " + std::to_string(row_major.size()) + " numbers");
   }
   const Eigen::Matrix3d rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(row_major.data());
-  if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-3 || rotation.determinant() < 0) {
+  if (!IsRotation(rotation)) {
     throw Error("'" + key + "' is not a rotation");
   }
   return rotation;
