@@ -88,7 +88,7 @@ StereoCalibration Rig() {
   return rig;
 }
 
-// The same rig with fisheye (Kannala–Brandt) lenses, about 110° across the diagonal.
+// The same rig with fisheye (Kannala–Brandt) lenses, about 105° across the diagonal.
 StereoCalibration FisheyeRig() {
   StereoCalibration rig = Rig();
   rig.left = Camera::KannalaBrandt(kWidth, kHeight, 210, 211, 160.5, 119.0, Eigen::Vector4d(0.04, -0.01, 0.002, 0));
