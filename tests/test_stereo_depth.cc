@@ -112,6 +112,7 @@ TEST(StereoDepth, ToolWritesTheSequencesDepth) {
   std::ostringstream log;
   log << std::ifstream(folder / "distorted.log").rdbuf();
   EXPECT_NE(log.str().find("needs a rectified pair with a pinhole camera"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("nrslam_import --format stereo"), std::string::npos) << log.str();  // the way out
   // A mono sequence is refused with a message, not a crash.
   ASSERT_EQ(std::system((tools + "/nrslam_simulate --preset sim-0 --frames 2 --width 160 --height 120 --quiet --out " +
                          (folder / "mono").string() + " > /dev/null").c_str()),

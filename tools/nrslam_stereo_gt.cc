@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
     // would give depth that looks right and is not.
     if (sequence.info().camera.model() != nrslam::CameraModelId::kPinhole) {
       throw nrslam::Error(folder + ": stereo depth needs a rectified pair with a pinhole camera, and this sequence's is " +
-                          sequence.info().camera.model_name() + " (rectify the pair first, e.g. cv::stereoRectify)");
+                          sequence.info().camera.model_name() +
+                          " (import the raw pair with nrslam_import --format stereo, which rectifies it)");
     }
     if (sequence.has_depth() && !overwrite) throw nrslam::Error(folder + " already has depth/ (use --overwrite)");
     nrslam::SequenceInfo info = sequence.info();
