@@ -4,8 +4,10 @@
 // and a video give the same images; calibrations that cannot give a side-by-side pair are refused.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>  // before OpenCV's Eigen bridge, which needs it
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -179,6 +181,16 @@ ImportOptions StereoImport(const fs::path& in) {
   return options;
 }
 
+// The rotation from the raw left camera to the rectified one, as the import recorded it.
+Eigen::Matrix3d RectifiedFromLeft(const SequenceInfo& info) {
+  const auto& rows = info.provenance.at("rectification").at("rectified_from_raw_left");
+  Eigen::Matrix3d rotation;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) rotation(r, c) = rows.at(r).at(c).get<double>();
+  }
+  return rotation;
+}
+
 double MedianDepthError(const cv::Mat& depth, const Camera& camera, const Eigen::Matrix3d& rectified_from_left,
                         double* coverage) {
   const TexturedPlane& plane = Plane();
@@ -213,11 +225,7 @@ TEST(StereoRectification, ARawDistortedPairGivesThePlanesTrueDepth) {
   EXPECT_EQ(info.camera.height(), kHeight);
 
   const SequenceReader sequence(folder / "seq");
-  const auto& rows = sequence.info().provenance.at("rectification").at("rectified_from_raw_left");
-  Eigen::Matrix3d rectified_from_left;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) rectified_from_left(r, c) = rows.at(r).at(c).get<double>();
-  }
+  const Eigen::Matrix3d rectified_from_left = RectifiedFromLeft(sequence.info());
   EXPECT_LT((rectified_from_left.transpose() * rectified_from_left - Eigen::Matrix3d::Identity()).norm(), 1e-9);
   ASSERT_TRUE(sequence.has_depth());
   EXPECT_EQ(sequence.info().provenance.at("depth").at("options").at("block_size"), StereoDepthOptions{}.block_size);
@@ -273,11 +281,7 @@ TEST(StereoRectification, ARawFisheyePairGivesThePlanesTrueDepth) {
   const SequenceInfo info = ImportDataset(options, folder / "seq");
   EXPECT_NEAR(info.stereo->baseline_mm, rig.right_from_left.translation.norm(), 1e-6);
   EXPECT_EQ(info.provenance.at("rectification").at("raw_left_camera").at("model"), "kannala_brandt");
-  const auto& rows = info.provenance.at("rectification").at("rectified_from_raw_left");
-  Eigen::Matrix3d rectified_from_left;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) rectified_from_left(r, c) = rows.at(r).at(c).get<double>();
-  }
+  const Eigen::Matrix3d rectified_from_left = RectifiedFromLeft(info);
   double coverage = 0;
   const double median =
       MedianDepthError(SequenceReader(folder / "seq").ReadDepthMm(0), info.camera, rectified_from_left, &coverage);
@@ -382,31 +386,29 @@ TEST(StereoRectification, KalibrAndRosCalibrationsGiveTheirRig) {
   }
   ExpectSameRig(ReadStereoCalibration({folder / "camchain.yaml"}, std::nullopt, 0.0), rig);
 
-  cv::Mat r1, r2, p1, p2, q;
-  const auto k = [](const Camera& c) { return cv::Matx33d(c.fx(), 0, c.cx(), 0, c.fy(), c.cy(), 0, 0, 1); };
-  const auto d = [](const Camera& c) {
-    return cv::Mat(std::vector<double>(c.params().begin() + 4, c.params().begin() + 9), true);
+  const auto opencv = [](const Eigen::MatrixXd& matrix) {
+    cv::Mat converted;
+    cv::eigen2cv(matrix, converted);
+    return converted;
   };
-  const Eigen::Matrix3d rotation = rig.right_from_left.rotation.toRotationMatrix();
-  cv::Matx33d r;
-  for (int i = 0; i < 9; ++i) r.val[i] = rotation(i / 3, i % 3);
-  const Eigen::Vector3d& t = rig.right_from_left.translation;
-  cv::stereoRectify(k(rig.left), d(rig.left), k(rig.right), d(rig.right), cv::Size(kWidth, kHeight), r,
-                    cv::Vec3d(t.x(), t.y(), t.z()) / 1000.0, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY, 0.3);
+  cv::Mat r1, r2, p1, p2, q;
+  const Eigen::Vector3d metres = rig.right_from_left.translation / 1000.0;
+  cv::stereoRectify(opencv(CameraMatrix(rig.left)), opencv(Distortion(rig.left)), opencv(CameraMatrix(rig.right)),
+                    opencv(Distortion(rig.right)), cv::Size(kWidth, kHeight),
+                    opencv(rig.right_from_left.rotation.toRotationMatrix()), opencv(metres), r1, r2, p1, p2, q,
+                    cv::CALIB_ZERO_DISPARITY, 0.3);
   const auto camera_info = [&](const fs::path& file, const Camera& camera, const cv::Mat& rectification,
                                const cv::Mat& projection) {
-    const auto eigen = [](const cv::Mat& m) {
-      Eigen::MatrixXd e(m.rows, m.cols);
-      for (int i = 0; i < m.rows; ++i)
-        for (int j = 0; j < m.cols; ++j) e(i, j) = m.at<double>(i, j);
-      return e;
+    const auto eigen = [](const cv::Mat& matrix) {
+      Eigen::MatrixXd converted;
+      cv::cv2eigen(matrix, converted);
+      return converted;
     };
-    const std::vector<double>& p = camera.params();
     std::ofstream(file) << "image_width: 320\nimage_height: 240\ncamera_name: narrow_stereo\ncamera_matrix:\n  rows: "
                            "3\n  cols: 3\n  data: "
-                        << FlowList(eigen(cv::Mat(k(camera))))
+                        << FlowList(CameraMatrix(camera))
                         << "\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: "
-                        << FlowList(Eigen::Matrix<double, 1, 5>(p[4], p[5], p[6], p[7], p[8]))
+                        << FlowList(Distortion(camera).transpose())
                         << "\nrectification_matrix:\n  rows: 3\n  cols: 3\n  data: " << FlowList(eigen(rectification))
                         << "\nprojection_matrix:\n  rows: 3\n  cols: 4\n  data: " << FlowList(eigen(projection))
                         << "\n";

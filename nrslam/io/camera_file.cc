@@ -209,6 +209,11 @@ Eigen::Matrix3d Rotation(const std::vector<double>& row_major, const std::string
   return rotation;
 }
 
+// The rotation stored under `key` of a map.
+Eigen::Matrix3d RotationEntry(const cv::FileNode& map, const std::string& key) {
+  return Rotation(EntryNumbers(map[key], key), key);
+}
+
 // OpenCV's names, from whichever file has each: OpenCV's stereo_calib sample writes the
 // intrinsics (M1 D1 M2 D2) and the extrinsics (R T) to two files.
 StereoCalibration OpenCvStereo(const std::vector<cv::FileStorage>& storages,
@@ -223,7 +228,7 @@ StereoCalibration OpenCvStereo(const std::vector<cv::FileStorage>& storages,
   StereoCalibration stereo;
   stereo.left = ReadOpenCvCamera(holding("M1"), {"M1"}, {"D1"}, size);
   stereo.right = ReadOpenCvCamera(holding("M2"), {"M2"}, {"D2"}, size);
-  const Eigen::Matrix3d rotation = Rotation(EntryNumbers(holding("R")["R"], "R"), "R");
+  const Eigen::Matrix3d rotation = RotationEntry(holding("R"), "R");
   const std::vector<double> t = EntryNumbers(holding("T")["T"], "T");
   if (t.size() != 3) throw Error("'T' must be 3 numbers, has " + std::to_string(t.size()));
   stereo.right_from_left =
@@ -284,10 +289,8 @@ StereoCalibration RosStereo(const cv::FileStorage& left, const cv::FileStorage& 
   StereoCalibration stereo;
   stereo.left = camera(left);
   stereo.right = camera(right);
-  const Eigen::Matrix3d r_left =
-      Rotation(EntryNumbers(left["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
-  const Eigen::Matrix3d r_right =
-      Rotation(EntryNumbers(right["rectification_matrix"], "rectification_matrix"), "rectification_matrix");
+  const Eigen::Matrix3d r_left = RotationEntry(left.root(), "rectification_matrix");
+  const Eigen::Matrix3d r_right = RotationEntry(right.root(), "rectification_matrix");
   const std::vector<double> p = EntryNumbers(right["projection_matrix"], "projection_matrix");
   if (p.size() != 12) throw Error("the right camera's projection_matrix must be 3x4");
   const Eigen::Vector3d offset(p[3] / p[0], p[7] / p[5], 0.0);
