@@ -857,6 +857,21 @@ TEST(MonocularRun, TriangulationOnTwoThreadsGivesTheSameRunAsOne) {
   EXPECT_EQ(two.summary.rmse_mm, one.summary.rmse_mm);  // exactly: the same points, the same order
 }
 
+// The runner hands the tracker each next frame to run its KLT ahead (tracking.klt_lookahead);
+// with mapping, candidates and their promotion to map points in between, the run is the same.
+TEST(MonocularRun, KltLookaheadGivesTheSameRunAsWithout) {
+  SystemOptions options;
+  options.tracking.klt_lookahead = false;
+  const MonocularOutcome without = RunMonocular("sim-3", options);
+  const MonocularOutcome with = RunMonocular("sim-3", SystemOptions{});
+  ASSERT_GT(without.new_points, 0);
+  EXPECT_EQ(with.summary.frames_tracked, without.summary.frames_tracked);
+  EXPECT_EQ(with.deformable_candidates, without.deformable_candidates);
+  EXPECT_EQ(with.new_points, without.new_points);
+  EXPECT_EQ(with.summary.map_points, without.summary.map_points);
+  EXPECT_EQ(with.summary.rmse_mm, without.summary.rmse_mm);  // exactly: the same points, the same order
+}
+
 // A DBA left to run beside tracking is applied on a fixed frame, so runs repeat exactly; the
 // motion tracked meanwhile is kept on top of its result, so a still scene stays accurate.
 TEST(MonocularRun, LaggedDbaIsRepeatableAndKeepsARigidSceneAccurate) {

@@ -564,13 +564,13 @@ void KltTracker::RefineAffine(const cv::Mat& image, size_t slot, float* x, float
 }
 
 void KltTracker::Track(const ImagePyramid& current, const std::vector<cv::Point2f>& guesses, double ssim_threshold,
-                       std::vector<KltResult>* results) const {
+                       std::vector<KltResult>* results, int threads) const {
   if (guesses.size() != points_.size()) {
     throw Error("KltTracker::Track: " + std::to_string(guesses.size()) + " guesses for " +
                 std::to_string(points_.size()) + " reference points");
   }
   results->resize(points_.size());
-#pragma omp parallel
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
   {
     std::vector<float> scratch(area_);
 #pragma omp for schedule(dynamic, 16)

@@ -53,9 +53,10 @@ class KltTracker {
   bool has_reference(size_t index) const { return level_valid_[index * levels_]; }
 
   // Tracks every reference point into `current`, starting from guesses[i] (level-0 px).
-  // `results` is resized to size(); an invalid guess (NaN) gives kLost.
+  // `results` is resized to size(); an invalid guess (NaN) gives kLost. Points are tracked
+  // independently, on `threads` threads (0: OpenMP's default), with the same results for any.
   void Track(const ImagePyramid& current, const std::vector<cv::Point2f>& guesses, double ssim_threshold,
-             std::vector<KltResult>* results) const;
+             std::vector<KltResult>* results, int threads = 0) const;
 
  private:
   KltOptions options_;

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <chrono>
+#include <deque>
 #include <fstream>
 #include <future>
 #include <iomanip>
@@ -66,18 +67,34 @@ FrameImages ReadFrame(const SequenceReader& reader, int frame) {
 }
 
 // Decoding a frame's PNGs and encoding its depth map are a fifth of a tracking run's time and
-// depend on nothing the tracker computes, so they run beside it, on the other core: the next
-// frame is read while this one is processed, and each depth map is written while the next
-// frame is. Results are the same as when done in line; only the wall-clock time changes.
+// depend on nothing the tracker computes, so they run beside it, on the other core: the two
+// frames after this one are read while it is processed (the tracker looks one ahead), and each
+// depth map is written while the next frame is. Results are the same as when done in line;
+// only the wall-clock time changes.
 class FrameIo {
  public:
-  FrameIo(const SequenceReader& reader, int first, int last) : reader_(reader), last_(last) { Prefetch(first); }
+  FrameIo(const SequenceReader& reader, int first, int last) : reader_(reader), next_(first), last_(last) {
+    Prefetch();
+    Prefetch();
+  }
 
-  // The frame's images; errors of reading it (a missing or corrupt file) are thrown here.
-  FrameImages Take(int frame) {
-    std::future<FrameImages> current = std::move(next_);
-    Prefetch(frame + 1);
+  // The frame's images (frames are taken in order); errors of reading it (a missing or corrupt
+  // file) are thrown here.
+  FrameImages Take() {
+    std::shared_future<FrameImages> current = std::move(ahead_.front());
+    ahead_.pop_front();
+    Prefetch();
     return current.get();
+  }
+  // The colour image of the frame after the last one taken, for the tracker to look ahead;
+  // empty when there is none or it cannot be read (Take reports that in its turn).
+  cv::Mat PeekNextBgr() const {
+    if (ahead_.empty()) return {};
+    try {
+      return ahead_.front().get().bgr;
+    } catch (const Error&) {
+      return {};
+    }
   }
 
   // Writes the image after the previous write has finished; throws if that one failed.
@@ -92,14 +109,15 @@ class FrameIo {
   }
 
  private:
-  void Prefetch(int frame) {
-    if (frame < last_) next_ = std::async(std::launch::async, ReadFrame, std::cref(reader_), frame);
+  void Prefetch() {
+    if (next_ < last_) ahead_.push_back(std::async(std::launch::async, ReadFrame, std::cref(reader_), next_++).share());
   }
   const SequenceReader& reader_;
+  int next_;  // the next frame to prefetch
   int last_;
-  // Futures of std::async wait for their thread when destroyed, so a run that unwinds early
-  // leaves no thread behind.
-  std::future<FrameImages> next_;
+  // Futures of std::async wait for their thread when the last one sharing it goes, so a run
+  // that unwinds early leaves no thread behind.
+  std::deque<std::shared_future<FrameImages>> ahead_;
   std::future<void> write_;
 };
 
@@ -158,13 +176,13 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     cv::Mat depth_mm;
     std::string depth_problem;
     try {
-      const FrameImages images = io.Take(frame);
+      const FrameImages images = io.Take();
       const cv::Mat& bgr = images.bgr;
       const cv::Mat& mask = images.mask;
       depth_mm = images.depth_mm;
       depth_problem = images.depth_problem;
       if (tracker.state() == TrackingState::kTracking) {
-        result = tracker.Track(frame, bgr, mask);
+        result = tracker.Track(frame, bgr, mask, io.PeekNextBgr());
         if (result.state == TrackingState::kLost) {
           log << "frame " << frame << ": lost (" << result.note << ")\n";
         } else if (options.run.mapping) {

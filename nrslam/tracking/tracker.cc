@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
+#include <utility>
 
 #include "nrslam/camera/reprojection_cost.h"
 #include "nrslam/deformation/regularizer_costs.h"
@@ -15,6 +17,7 @@
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
 #include "nrslam/geometry/se3_manifold.h"
+#include "nrslam/util/concurrent.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/stopwatch.h"
 
@@ -31,6 +34,17 @@ ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType sol
   options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   options.logging_type = ceres::SILENT;
   return options;
+}
+
+// Byte for byte: a look-ahead is only re-used for the image it ran on, even if a caller hands
+// the next frame in a buffer it later overwrites (as a video grabber does).
+bool SameImage(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size != b.size || a.type() != b.type()) return false;
+  const size_t row_bytes = a.cols * a.elemSize();
+  for (int row = 0; row < a.rows; ++row) {
+    if (std::memcmp(a.ptr(row), b.ptr(row), row_bytes) != 0) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -114,6 +128,7 @@ FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv:
   point_motion_.clear();
   tracks_.clear();
   lost_.clear();
+  lookahead_.reset();
   if (static_cast<int>(seed.points.size()) < options_.min_points) {
     return Lost(result, "too few points to start a map (" + std::to_string(seed.points.size()) + ")");
   }
@@ -176,6 +191,7 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
   }
   tracks_ = std::move(active);
   klt_.SetReference(*keyframe, pixels, valid);
+  ++reference_generation_;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (klt_.has_reference(i)) {
       tracks_[i].patch = {keyframe, tracks_[i].pixel};
@@ -423,21 +439,137 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
   return times;
 }
 
-FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
+std::vector<cv::Point2f> Tracker::KltGuesses() const {
+  std::vector<cv::Point2f> guesses;
+  guesses.reserve(tracks_.size());
+  for (const PointTrack& track : tracks_) guesses.push_back(track.active ? track.pixel : cv::Point2f(NAN, NAN));
+  return guesses;
+}
+
+void Tracker::MatchTracks(const ImagePyramid& pyramid, const std::vector<cv::Point2f>& guesses, const Lookahead* ahead,
+                          std::vector<KltResult>* matches) const {
+  // The look-ahead ran every track there was then, from the pixel it still has (tracks move
+  // only here) unless it is inactive now (a track is never reactivated: a point found again
+  // gets a new one); the tracks after those were re-associated since.
+  const size_t done = ahead ? std::min(ahead->guesses.size(), guesses.size()) : 0;
+  std::vector<cv::Point2f> rest = guesses;
+  std::fill(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(done), cv::Point2f(NAN, NAN));
+  if (std::any_of(rest.begin(), rest.end(), [](const cv::Point2f& guess) { return !std::isnan(guess.x); })) {
+    klt_.Track(pyramid, rest, frontend_.klt.ssim_tracking, matches);
+  } else {
+    matches->assign(guesses.size(), KltResult{});
+  }
+  if (ahead) std::copy_n(ahead->matches.begin(), done, matches->begin());
+}
+
+Tracker::Lookahead Tracker::RunAhead(const cv::Mat& next_bgr, std::vector<cv::Point2f> guesses,
+                                     int reference_generation) const {
+  const auto start = Clock::now();
+  Lookahead ahead;
+  ahead.grey = ToGrey(next_bgr);
+  ahead.pyramid = std::make_shared<const ImagePyramid>(ahead.grey, frontend_.klt.levels);
+  ahead.guesses = std::move(guesses);
+  // One thread: the other core is this frame's solve.
+  klt_.Track(*ahead.pyramid, ahead.guesses, frontend_.klt.ssim_tracking, &ahead.matches, 1);
+  ahead.reference_generation = reference_generation;
+  ahead.ms = MillisecondsSince(start);
+  return ahead;
+}
+
+std::optional<std::string> Tracker::SolvePoseAndDeformation(std::vector<Observation>* observations_in_view,
+                                                            FrameSolution* solution, FrameResult* result) {
+  // Pose: constant-velocity seed, rigid refinement. A point that the seed puts behind the
+  // camera (or outside the lens) would make every Ceres evaluation fail: it sits this frame out.
+  const auto pose_start = Clock::now();
+  std::vector<Observation>& observations = *observations_in_view;
+  Rigid3& pose = solution->pose;
+  pose = motion_ * cam_from_world_;
+  observations.erase(std::remove_if(observations.begin(), observations.end(),
+                                    [&](const Observation& o) {
+                                      return !camera_.Project(pose * map_->point(o.id).position);
+                                    }),
+                     observations.end());
+  if (static_cast<int>(observations.size()) < options_.min_points) {
+    return "only " + std::to_string(observations.size()) + " points in front of the camera";
+  }
+  std::vector<Eigen::Vector3d> motion_seeds(observations.size(), Eigen::Vector3d::Zero());
+  if (!options_.rigid && options_.deformation_motion_seed) {
+    for (size_t i = 0; i < observations.size(); ++i) {
+      const auto id = static_cast<size_t>(observations[i].id);
+      if (id < point_motion_.size()) motion_seeds[i] = point_motion_[id];  // new points: none yet
+    }
+    motion_seeds = WithoutCommonMotion(std::move(motion_seeds));
+  }
+  std::vector<bool>& inliers = solution->inliers;
+  inliers = RefinePose(observations, motion_seeds, &pose);
+  result->ms_pose = MillisecondsSince(pose_start);
+
+  // Deformation.
+  const auto deformation_start = Clock::now();
+  std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
+  std::vector<bool>& demoted = solution->demoted;
+  demoted.assign(observations.size(), false);
+  if (!options_.rigid) {
+    // This frame's seeds are taken: the buffer now holds where every point starts, and below
+    // becomes how far tracking moved it (the next frame's seeds), without a new allocation.
+    if (options_.deformation_motion_seed) {
+      point_motion_.resize(map_->size());
+      for (size_t id = 0; id < point_motion_.size(); ++id) point_motion_[id] = map_->points()[id].position;
+    }
+    const JointSolveTimes times = SolveDeformation(observations, motion_seeds, &pose, &displacements, &inliers);
+    result->ms_joint_solve = times.ms_total;
+    result->ms_linear_solve = times.ms_linear;
+    // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
+    std::vector<double> norms;
+    for (const auto& d : displacements) norms.push_back(d.norm());
+    std::vector<double> sorted = norms;
+    std::sort(sorted.begin(), sorted.end());
+    const double q1 = sorted[sorted.size() / 4], q3 = sorted[(3 * sorted.size()) / 4];
+    const double fence = q3 + options_.displacement_iqr_factor * (q3 - q1);
+    std::vector<double> inlier_norms;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (inliers[i]) inlier_norms.push_back(norms[i]);
+    }
+    if (!inlier_norms.empty()) result->median_displacement = Median(inlier_norms);
+    for (size_t i = 0; i < observations.size(); ++i) {
+      demoted[i] = norms[i] >= fence && norms[i] > 0;
+      if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
+    }
+    std::vector<std::optional<Eigen::Vector3d>> optimised(map_->size());
+    std::vector<PointId> demoted_ids, updated_ids;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (demoted[i]) demoted_ids.push_back(observations[i].id);
+      if (!inliers[i] || demoted[i]) continue;
+      updated_ids.push_back(observations[i].id);
+      optimised[static_cast<size_t>(observations[i].id)] = displacements[i];
+    }
+    map_->graph().UpdatePoints(updated_ids, map_->Positions());
+    result->propagated = PropagateMotion(optimised, demoted_ids);
+    for (size_t id = 0; id < point_motion_.size(); ++id) {
+      point_motion_[id] = map_->points()[id].position - point_motion_[id];
+    }
+  }
+  result->ms_deformation = MillisecondsSince(deformation_start);
+  return std::nullopt;
+}
+
+FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, const cv::Mat& next_bgr) {
   const auto start = Clock::now();
   FrameResult result;
   result.frame = frame;
   if (state_ != TrackingState::kTracking) return Lost(result, "no map to track");
 
-  // Short-term association.
+  // Short-term association, from the look-ahead the previous frame ran if it ran on this image.
   const cv::Mat grey = ToGrey(bgr);
-  const auto pyramid = std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels);
-  std::vector<cv::Point2f> guesses;
-  for (const PointTrack& track : tracks_) {
-    guesses.push_back(track.active ? track.pixel : cv::Point2f(NAN, NAN));
-  }
+  std::optional<Lookahead> ahead = std::exchange(lookahead_, std::nullopt);
+  if (ahead && !SameImage(ahead->grey, grey)) ahead.reset();
+  // Its pyramid still serves; its matches do not once the reference patches have been replaced.
+  if (ahead && ahead->reference_generation != reference_generation_) ahead->guesses.clear();
+  const auto pyramid = ahead ? ahead->pyramid : std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels);
+  const std::vector<cv::Point2f> guesses = KltGuesses();
   std::vector<KltResult> matches;
-  klt_.Track(*pyramid, guesses, frontend_.klt.ssim_tracking, &matches);
+  MatchTracks(*pyramid, guesses, ahead ? &*ahead : nullptr, &matches);
+  if (ahead) result.ms_klt_ahead = ahead->ms;
   std::vector<Observation> observations;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;
@@ -458,72 +590,28 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
     return Lost(result, "only " + std::to_string(observations.size()) + " points tracked");
   }
 
-  // Pose: constant-velocity seed, rigid refinement. A point that the seed puts behind the
-  // camera (or outside the lens) would make every Ceres evaluation fail: it sits this frame out.
-  const auto pose_start = Clock::now();
-  Rigid3 pose = motion_ * cam_from_world_;
-  observations.erase(std::remove_if(observations.begin(), observations.end(),
-                                    [&](const Observation& o) {
-                                      return !camera_.Project(pose * map_->point(o.id).position);
-                                    }),
-                     observations.end());
-  if (static_cast<int>(observations.size()) < options_.min_points) {
-    return Lost(result, "only " + std::to_string(observations.size()) + " points in front of the camera");
+  // Pose and deformation; beside them, on the other core, the next frame's pyramid and KLT
+  // from the tracks as they are now, and this frame's validity mask, which re-association will
+  // most likely need. (On a frame that refreshes the reference only the pyramid will serve.)
+  FrameSolution solution;
+  std::optional<std::string> lost;
+  const auto solve = [&] { lost = SolvePoseAndDeformation(&observations, &solution, &result); };
+  cv::Mat valid;
+  if (options_.klt_lookahead && !next_bgr.empty()) {
+    Lookahead next;
+    const auto run_ahead = [&, guesses = KltGuesses()] {
+      next = RunAhead(next_bgr, guesses, reference_generation_);
+      valid = BuildValidityMask(grey, mask, frontend_.masks);
+    };
+    RunConcurrently(run_ahead, solve);
+    lookahead_ = std::move(next);
+  } else {
+    solve();
   }
-  std::vector<Eigen::Vector3d> motion_seeds(observations.size(), Eigen::Vector3d::Zero());
-  if (!options_.rigid && options_.deformation_motion_seed) {
-    for (size_t i = 0; i < observations.size(); ++i) {
-      const auto id = static_cast<size_t>(observations[i].id);
-      if (id < point_motion_.size()) motion_seeds[i] = point_motion_[id];  // new points: none yet
-    }
-    motion_seeds = WithoutCommonMotion(std::move(motion_seeds));
-  }
-  std::vector<bool> inliers = RefinePose(observations, motion_seeds, &pose);
-  result.ms_pose = MillisecondsSince(pose_start);
-
-  // Deformation.
-  const auto deformation_start = Clock::now();
-  std::vector<Eigen::Vector3d> displacements(observations.size(), Eigen::Vector3d::Zero());
-  std::vector<bool> demoted(observations.size(), false);
-  if (!options_.rigid) {
-    // This frame's seeds are taken: the buffer now holds where every point starts, and below
-    // becomes how far tracking moved it (the next frame's seeds), without a new allocation.
-    if (options_.deformation_motion_seed) {
-      point_motion_.resize(map_->size());
-      for (size_t id = 0; id < point_motion_.size(); ++id) point_motion_[id] = map_->points()[id].position;
-    }
-    const JointSolveTimes times = SolveDeformation(observations, motion_seeds, &pose, &displacements, &inliers);
-    result.ms_joint_solve = times.ms_total;
-    result.ms_linear_solve = times.ms_linear;
-    // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
-    std::vector<double> norms;
-    for (const auto& d : displacements) norms.push_back(d.norm());
-    std::vector<double> sorted = norms;
-    std::sort(sorted.begin(), sorted.end());
-    const double q1 = sorted[sorted.size() / 4], q3 = sorted[(3 * sorted.size()) / 4];
-    const double fence = q3 + options_.displacement_iqr_factor * (q3 - q1);
-    std::vector<double> inlier_norms;
-    for (size_t i = 0; i < observations.size(); ++i) {
-      if (inliers[i]) inlier_norms.push_back(norms[i]);
-    }
-    if (!inlier_norms.empty()) result.median_displacement = Median(inlier_norms);
-    for (size_t i = 0; i < observations.size(); ++i) {
-      demoted[i] = norms[i] >= fence && norms[i] > 0;
-      if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
-    }
-    std::vector<std::optional<Eigen::Vector3d>> optimised(map_->size());
-    std::vector<PointId> demoted_ids, updated_ids;
-    for (size_t i = 0; i < observations.size(); ++i) {
-      if (demoted[i]) demoted_ids.push_back(observations[i].id);
-      if (!inliers[i] || demoted[i]) continue;
-      updated_ids.push_back(observations[i].id);
-      optimised[static_cast<size_t>(observations[i].id)] = displacements[i];
-    }
-    map_->graph().UpdatePoints(updated_ids, map_->Positions());
-    result.propagated = PropagateMotion(optimised, demoted_ids);
-    for (size_t id = 0; id < point_motion_.size(); ++id) point_motion_[id] = map_->points()[id].position - point_motion_[id];
-  }
-  result.ms_deformation = MillisecondsSince(deformation_start);
+  if (lost) return Lost(result, *lost);
+  const Rigid3& pose = solution.pose;
+  const std::vector<bool>& inliers = solution.inliers;
+  const std::vector<bool>& demoted = solution.demoted;
 
   for (size_t i = 0; i < observations.size(); ++i) {
     // An outlier sits this frame out but stays a 2D track: the KLT keeps following it and it
@@ -546,7 +634,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask) {
   // One validity mask per frame, shared by re-association and a reference refresh.
   const bool refresh = frames_since_keyframe_ + 1 >= options_.keyframe_period;
   const bool search = options_.reassociation && !lost_.empty();
-  const cv::Mat valid = search || refresh ? BuildValidityMask(grey, mask, frontend_.masks) : cv::Mat();
+  if ((search || refresh) && valid.empty()) valid = BuildValidityMask(grey, mask, frontend_.masks);
   if (search) Reassociate(*pyramid, valid, &result);
   if (static_cast<int>(result.points.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");

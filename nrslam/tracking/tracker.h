@@ -55,6 +55,9 @@ struct FrameResult {
   int propagated = 0;                // lost or demoted points moved with their neighbours
   int reassociated = 0;              // lost points found again
   double ms_klt = 0, ms_pose = 0, ms_deformation = 0, ms_total = 0;
+  // The part of this frame's KLT that ran ahead, during the previous frame's solve, on another
+  // thread: not in ms_klt nor ms_total (which are this frame's own wall-clock).
+  double ms_klt_ahead = 0;
   // Inside ms_deformation: Ceres's time in the joint solves (all rounds), and the part of it
   // spent in the linear solver (factorising or CG), which is where deformable tracking's time goes.
   double ms_joint_solve = 0, ms_linear_solve = 0;
@@ -87,7 +90,11 @@ class Tracker {
   // Starts a new map from `seed` (e.g. a monocular initialisation) on this frame. Seed point
   // i becomes map point i.
   FrameResult InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv::Mat& mask, const MapSeed& seed);
-  FrameResult Track(int frame, const cv::Mat& bgr, const cv::Mat& mask);
+  // Tracks this frame. `next_bgr`, when the caller already has it, is the next frame's image:
+  // with `klt_lookahead` its KLT then runs beside this frame's solve, and the next Track uses
+  // those results if it is given the same image (compared by content) and the tracks have not
+  // changed since. Results never depend on whether it is given.
+  FrameResult Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, const cv::Mat& next_bgr = {});
 
   // With candidates on, each keyframe adds new corners as 2D tracks for mapping to triangulate.
   void EnableCandidates(bool on) { candidates_ = on; }
@@ -127,6 +134,15 @@ class Tracker {
     PointId id;
     Eigen::Vector2d pixel;
   };
+  // The next frame's KLT, run ahead from the tracks as they were after this frame's KLT.
+  struct Lookahead {
+    cv::Mat grey;                        // the image it ran on
+    std::shared_ptr<const ImagePyramid> pyramid;
+    std::vector<cv::Point2f> guesses;    // per track index; NaN for inactive tracks
+    std::vector<KltResult> matches;
+    int reference_generation = 0;        // the KLT reference it tracked against
+    double ms = 0;
+  };
 
   Camera camera_;
   FrontendOptions frontend_;
@@ -145,11 +161,31 @@ class Tracker {
   int frames_since_keyframe_ = 0;
   bool candidates_ = false;
   int next_track_id_ = 0;
+  int reference_generation_ = 0;  // counts SetReference calls: a look-ahead from an older one is void
+  std::optional<Lookahead> lookahead_;
 
   // Cuts new reference patches in `keyframe`; `valid` is its validity mask. With candidates
   // on and a grey image given, new corners away from every track join as candidates.
   void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid,
                         const cv::Mat& grey = {});
+  // Where the KLT starts each track in the next image: its last pixel, NaN when inactive.
+  std::vector<cv::Point2f> KltGuesses() const;
+  // The short-term KLT of every track into `pyramid` from `guesses`, re-using the results of
+  // a look-ahead (run against the current reference) for the tracks it ran.
+  void MatchTracks(const ImagePyramid& pyramid, const std::vector<cv::Point2f>& guesses, const Lookahead* ahead,
+                   std::vector<KltResult>* matches) const;
+  // What the pose and deformation stage leaves for the rest of the frame.
+  struct FrameSolution {
+    Rigid3 pose;
+    std::vector<bool> inliers, demoted;  // per observation
+  };
+  // Constant-velocity seed and rigid refinement of the pose, then (unless rigid) the joint
+  // solve, demotion of outliers, graph update and propagation to lost and demoted points.
+  // Drops the observations the seed puts behind the camera; returns why the frame is lost.
+  std::optional<std::string> SolvePoseAndDeformation(std::vector<Observation>* observations_in_view,
+                                                     FrameSolution* solution, FrameResult* result);
+  // The next frame's KLT from the tracks as they are now (run beside this frame's solve).
+  Lookahead RunAhead(const cv::Mat& next_bgr, std::vector<cv::Point2f> guesses, int reference_generation) const;
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.

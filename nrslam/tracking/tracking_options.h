@@ -44,6 +44,11 @@ struct TrackingOptions {
   int reassociation_levels = 2;            // pyramid levels of that KLT (the seed is close)
   double reassociation_gate_px2 = 5.99;    // squared px between the found position and the projection
   int lost_max_age_frames = 90;   // a point lost longer ago is neither moved nor looked for (bounds work)
+  // When the caller hands Track the next frame's image, that frame's KLT runs on a second
+  // thread while this frame's pose and deformation are solved. The results are the same to the
+  // last bit either way (a point's KLT depends only on its patch, its guess and the image);
+  // off, tracking uses one core but for the KLT's own threads.
+  bool klt_lookahead = true;
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
@@ -51,6 +56,6 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_poin
                                                 deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
                                                 displacement_prior_sigma, deformation_motion_seed,
                                                 reassociation, reassociation_levels, reassociation_gate_px2,
-                                                lost_max_age_frames)
+                                                lost_max_age_frames, klt_lookahead)
 
 }  // namespace nrslam
