@@ -597,7 +597,8 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   std::optional<std::string> lost;
   const auto solve = [&] { lost = SolvePoseAndDeformation(&observations, &solution, &result); };
   cv::Mat valid;
-  if (options_.klt_lookahead && !next_bgr.empty()) {
+  // Not in rigid mode: its pose-only solve is shorter than the KLT on one core, which it would wait for.
+  if (options_.klt_lookahead && !options_.rigid && !next_bgr.empty()) {
     Lookahead next;
     const auto run_ahead = [&, guesses = KltGuesses()] {
       next = RunAhead(next_bgr, guesses, reference_generation_);

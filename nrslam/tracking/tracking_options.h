@@ -45,9 +45,9 @@ struct TrackingOptions {
   double reassociation_gate_px2 = 5.99;    // squared px between the found position and the projection
   int lost_max_age_frames = 90;   // a point lost longer ago is neither moved nor looked for (bounds work)
   // When the caller hands Track the next frame's image, that frame's KLT runs on a second
-  // thread while this frame's pose and deformation are solved. The results are the same to the
-  // last bit either way (a point's KLT depends only on its patch, its guess and the image);
-  // off, tracking uses one core but for the KLT's own threads.
+  // thread while this frame's pose and deformation are solved (deformable mode only). The
+  // results are the same to the last bit either way (a point's KLT depends only on its patch,
+  // its guess and the image); off, tracking uses one core but for the KLT's own threads.
   bool klt_lookahead = true;
   void Check() const;
 };
