@@ -55,8 +55,8 @@ struct FrameResult {
   int propagated = 0;                // lost or demoted points moved with their neighbours
   int reassociated = 0;              // lost points found again
   double ms_klt = 0, ms_pose = 0, ms_deformation = 0, ms_total = 0;
-  // The part of this frame's KLT that ran ahead, during the previous frame's solve, on another
-  // thread: not in ms_klt nor ms_total (which are this frame's own wall-clock).
+  // Time spent ahead on this frame's image (grey, pyramid, KLT) during the previous frame's
+  // solve, on another thread: not in ms_klt nor ms_total (this frame's own wall-clock).
   double ms_klt_ahead = 0;
   // Inside ms_deformation: Ceres's time in the joint solves (all rounds), and the part of it
   // spent in the linear solver (factorising or CG), which is where deformable tracking's time goes.
@@ -92,8 +92,9 @@ class Tracker {
   FrameResult InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv::Mat& mask, const MapSeed& seed);
   // Tracks this frame. `next_bgr`, when the caller already has it, is the next frame's image:
   // with `klt_lookahead` its KLT then runs beside this frame's solve, and the next Track uses
-  // those results if it is given the same image (compared by content) and the tracks have not
-  // changed since. Results never depend on whether it is given.
+  // those results if it is given the same image (compared by content) and the reference
+  // patches are still the same; tracks re-associated meanwhile are tracked then. Results never
+  // depend on whether it is given.
   FrameResult Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, const cv::Mat& next_bgr = {});
 
   // With candidates on, each keyframe adds new corners as 2D tracks for mapping to triangulate.
