@@ -563,12 +563,12 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   const cv::Mat grey = ToGrey(bgr);
   std::optional<Lookahead> ahead = std::exchange(lookahead_, std::nullopt);
   if (ahead && !SameImage(ahead->grey, grey)) ahead.reset();
-  // Its pyramid still serves; its matches do not once the reference patches have been replaced.
-  if (ahead && ahead->reference_generation != reference_generation_) ahead->guesses.clear();
   const auto pyramid = ahead ? ahead->pyramid : std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels);
+  // Its pyramid still serves; its matches do not once the reference patches have been replaced.
+  const bool matches_ahead = ahead && ahead->reference_generation == reference_generation_;
   const std::vector<cv::Point2f> guesses = KltGuesses();
   std::vector<KltResult> matches;
-  MatchTracks(*pyramid, guesses, ahead ? &*ahead : nullptr, &matches);
+  MatchTracks(*pyramid, guesses, matches_ahead ? &*ahead : nullptr, &matches);
   if (ahead) result.ms_klt_ahead = ahead->ms;
   std::vector<Observation> observations;
   for (size_t i = 0; i < tracks_.size(); ++i) {
