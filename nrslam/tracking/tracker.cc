@@ -451,7 +451,7 @@ void Tracker::MatchTracks(const ImagePyramid& pyramid, const std::vector<cv::Poi
   // The look-ahead ran every track there was then, from the pixel it still has (tracks move
   // only here) unless it is inactive now (a track is never reactivated: a point found again
   // gets a new one); the tracks after those were re-associated since.
-  const size_t done = ahead ? std::min(ahead->guesses.size(), guesses.size()) : 0;
+  const size_t done = ahead ? std::min(ahead->matches.size(), guesses.size()) : 0;
   std::vector<cv::Point2f> rest = guesses;
   std::fill(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(done), cv::Point2f(NAN, NAN));
   if (std::any_of(rest.begin(), rest.end(), [](const cv::Point2f& guess) { return !std::isnan(guess.x); })) {
@@ -462,15 +462,14 @@ void Tracker::MatchTracks(const ImagePyramid& pyramid, const std::vector<cv::Poi
   if (ahead) std::copy_n(ahead->matches.begin(), done, matches->begin());
 }
 
-Tracker::Lookahead Tracker::RunAhead(const cv::Mat& next_bgr, std::vector<cv::Point2f> guesses,
+Tracker::Lookahead Tracker::RunAhead(const cv::Mat& next_bgr, const std::vector<cv::Point2f>& guesses,
                                      int reference_generation) const {
   const auto start = Clock::now();
   Lookahead ahead;
   ahead.grey = ToGrey(next_bgr);
   ahead.pyramid = std::make_shared<const ImagePyramid>(ahead.grey, frontend_.klt.levels);
-  ahead.guesses = std::move(guesses);
   // One thread: the other core is this frame's solve.
-  klt_.Track(*ahead.pyramid, ahead.guesses, frontend_.klt.ssim_tracking, &ahead.matches, 1);
+  klt_.Track(*ahead.pyramid, guesses, frontend_.klt.ssim_tracking, &ahead.matches, 1);
   ahead.reference_generation = reference_generation;
   ahead.ms = MillisecondsSince(start);
   return ahead;

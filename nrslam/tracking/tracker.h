@@ -139,8 +139,7 @@ class Tracker {
   struct Lookahead {
     cv::Mat grey;                        // the image it ran on
     std::shared_ptr<const ImagePyramid> pyramid;
-    std::vector<cv::Point2f> guesses;    // per track index; NaN for inactive tracks
-    std::vector<KltResult> matches;
+    std::vector<KltResult> matches;      // per track index, for the tracks there were then
     int reference_generation = 0;        // the KLT reference it tracked against
     double ms = 0;
   };
@@ -186,7 +185,7 @@ class Tracker {
   std::optional<std::string> SolvePoseAndDeformation(std::vector<Observation>* observations_in_view,
                                                      FrameSolution* solution, FrameResult* result);
   // The next frame's KLT from the tracks as they are now (run beside this frame's solve).
-  Lookahead RunAhead(const cv::Mat& next_bgr, std::vector<cv::Point2f> guesses, int reference_generation) const;
+  Lookahead RunAhead(const cv::Mat& next_bgr, const std::vector<cv::Point2f>& guesses, int reference_generation) const;
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
