@@ -240,6 +240,28 @@ TEST(DeformationGraph, FlagsPointsLeftWithTooFewEdges) {
 
 // The graph keeps per-point counts and a packed copy of the weights for speed; after any
 // sequence of updates they must say what the edge records themselves say.
+// The point's unpruned-edge count and best D edges, worked out from the edge records alone.
+void ExpectCountsAndBestEdgesFromTheRecords(const DeformationGraph& graph, const DeformationModelOptions& options,
+                                            PointId id) {
+  int unpruned = 0;
+  std::vector<std::pair<double, PointId>> usable;
+  for (const int e : graph.EdgeIndices()) {
+    const GraphEdge& edge = graph.edge(e);
+    if (edge.a != id && edge.b != id) continue;
+    if (!edge.pruned) ++unpruned;
+    if (!edge.pruned && edge.weight >= options.min_edge_weight) usable.emplace_back(-edge.weight, edge.a == id ? edge.b : edge.a);
+  }
+  EXPECT_EQ(graph.GoodEdgeCount(id), unpruned) << "point " << id;
+  std::sort(usable.begin(), usable.end());
+  usable.resize(std::min<size_t>(usable.size(), static_cast<size_t>(options.max_degree_D)));
+  const auto best = graph.BestNeighbours(id);
+  ASSERT_EQ(best.size(), usable.size()) << "point " << id;
+  for (size_t i = 0; i < best.size(); ++i) {
+    EXPECT_EQ(best[i].id, usable[i].second) << "point " << id;
+    EXPECT_EQ(best[i].weight, -usable[i].first) << "point " << id;
+  }
+}
+
 TEST(DeformationGraph, CountsAndBestEdgesAgreeWithTheEdgeRecordsAfterUpdates) {
   DeformationModelOptions options;
   options.max_degree_D = 4;
@@ -258,25 +280,7 @@ TEST(DeformationGraph, CountsAndBestEdgesAgreeWithTheEdgeRecordsAfterUpdates) {
   }
   ASSERT_GT(graph.pruned_count(), 0u);
   ASSERT_LT(graph.pruned_count(), graph.edge_count());
-  for (const PointId id : positions.Ids()) {
-    int unpruned = 0;
-    std::vector<std::pair<double, PointId>> usable;
-    for (const int e : graph.EdgeIndices()) {
-      const GraphEdge& edge = graph.edge(e);
-      if (edge.a != id && edge.b != id) continue;
-      if (!edge.pruned) ++unpruned;
-      if (!edge.pruned && edge.weight >= options.min_edge_weight) usable.emplace_back(-edge.weight, edge.a == id ? edge.b : edge.a);
-    }
-    EXPECT_EQ(graph.GoodEdgeCount(id), unpruned);
-    std::sort(usable.begin(), usable.end());
-    usable.resize(std::min<size_t>(usable.size(), 4));
-    const auto best = graph.BestNeighbours(id);
-    ASSERT_EQ(best.size(), usable.size());
-    for (size_t i = 0; i < best.size(); ++i) {
-      EXPECT_EQ(best[i].id, usable[i].second);
-      EXPECT_EQ(best[i].weight, -usable[i].first);
-    }
-  }
+  for (const PointId id : positions.Ids()) ExpectCountsAndBestEdgesFromTheRecords(graph, options, id);
 }
 
 TEST(DeformationGraph, RetiringErasesOnlyTheEdgesBetweenRetiredPoints) {
@@ -356,6 +360,9 @@ TEST(DeformationGraph, RetiringChangesNoAnswerAboutLivePoints) {
     add_points(4);
     for (const PointId id : live) {
       ASSERT_EQ(kept.GoodEdgeCount(id), retiring.GoodEdgeCount(id)) << "point " << id << " at step " << step;
+      // Not only the same answers: the right ones, though edges of retired points were erased
+      // and new ones took their slots.
+      ExpectCountsAndBestEdgesFromTheRecords(retiring, options, id);
       const auto a = kept.BestNeighbours(id), b = retiring.BestNeighbours(id);
       ASSERT_EQ(a.size(), b.size());
       for (size_t n = 0; n < a.size(); ++n) {

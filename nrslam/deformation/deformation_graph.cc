@@ -25,24 +25,38 @@ void DeformationGraph::set_sigma(double sigma) {
   }
 }
 
+double DeformationGraph::RankingWeight(const GraphEdge& edge) const {
+  return edge.pruned || edge.weight < options_.min_edge_weight ? -1.0 : edge.weight;
+}
+
 void DeformationGraph::UpdateRanking(int index) {
   const GraphEdge& edge = edges_[index];
-  ranking_weight_[index] = edge.pruned || edge.weight < options_.min_edge_weight ? -1.0 : edge.weight;
+  const double ranking = RankingWeight(edge);
+  for (int end = 0; end < 2; ++end) {
+    Node& node = nodes_[static_cast<size_t>(end == 0 ? edge.a : edge.b)];
+    const auto slot = static_cast<size_t>(slots_[index][end]);
+    if (slot < node.ranking.size()) node.ranking[slot] = ranking;  // a retired end has no list
+  }
 }
 
 void DeformationGraph::Remeasure(int index, double length) {
   GraphEdge& edge = edges_[index];
-  edge.min_length = std::min(edge.min_length, length);
-  if (length > edge.max_length) {  // the weight follows the longest length (an exp: only when it grows)
+  const bool longer = length > edge.max_length;
+  if (length < edge.min_length) edge.min_length = length;
+  if (longer) {  // the weight follows the longest length (an exp: only when it grows)
     edge.max_length = length;
     edge.weight = WeightOf(length);
   }
   if (!edge.pruned && (edge.max_length - edge.min_length) / edge.min_length > options_.stretch_threshold) {
     edge.pruned = true;
-    --nodes_[edge.a].unpruned;
-    --nodes_[edge.b].unpruned;
+    --nodes_[static_cast<size_t>(edge.a)].unpruned;
+    --nodes_[static_cast<size_t>(edge.b)].unpruned;
   }
   UpdateRanking(index);
+}
+
+const DeformationGraph::Node* DeformationGraph::FindNode(PointId point) const {
+  return point >= 0 && static_cast<size_t>(point) < nodes_.size() ? &nodes_[static_cast<size_t>(point)] : nullptr;
 }
 
 double DeformationGraph::WeightOf(double max_length) const {
@@ -60,9 +74,9 @@ std::optional<int> DeformationGraph::FindEdge(PointId a, PointId b) const {
   const GraphEdge& edge = edges_[candidates->second];
   if ((edge.a == a && edge.b == b) || (edge.a == b && edge.b == a)) return candidates->second;
   // A key collision (only possible for ids beyond 2³²): fall back to the adjacency list.
-  const auto node = nodes_.find(a);
-  if (node == nodes_.end()) return std::nullopt;
-  for (const Incidence& incidence : node->second.edges) {
+  const Node* node = FindNode(a);
+  if (!node) return std::nullopt;
+  for (const Incidence& incidence : node->edges) {
     const GraphEdge& candidate = edges_[incidence.edge];
     if (incidence.other == b && (candidate.a == b || candidate.b == b)) return incidence.edge;
   }
@@ -72,6 +86,7 @@ std::optional<int> DeformationGraph::FindEdge(PointId a, PointId b) const {
 void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
   CheckLive(a);
   CheckLive(b);
+  if (a < 0 || b < 0) throw Error("deformation graph: point ids are map indices, got a negative one");
   if (a == b || FindEdge(a, b)) return;
   if (!(length > 0) || !std::isfinite(length)) return;  // coincident or invalid points: no direction to regularise
   const GraphEdge edge{a, b, length, length, length, WeightOf(length), false};
@@ -79,16 +94,19 @@ void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
   if (free_edges_.empty()) {
     index = static_cast<int>(edges_.size());
     edges_.push_back(edge);
-    ranking_weight_.push_back(0.0);
+    slots_.emplace_back();
   } else {
     index = free_edges_.back();
     free_edges_.pop_back();
     edges_[index] = edge;
   }
-  UpdateRanking(index);
+  nodes_.resize(std::max(nodes_.size(), static_cast<size_t>(std::max(a, b)) + 1));
+  int end = 0;
   for (const auto& [from, to] : {std::pair(a, b), std::pair(b, a)}) {
-    Node& node = nodes_[from];
+    Node& node = nodes_[static_cast<size_t>(from)];
+    slots_[index][end++] = static_cast<int>(node.edges.size());
     node.edges.push_back({to, index});
+    node.ranking.push_back(RankingWeight(edge));
     ++node.unpruned;
     ++node.present;
   }
@@ -100,14 +118,13 @@ void DeformationGraph::EraseEdge(int index) {
   const auto key = edge_index_.find(PairKey(edge.a, edge.b));
   if (key != edge_index_.end() && key->second == index) edge_index_.erase(key);
   for (const PointId end : {edge.a, edge.b}) {
-    const auto node = nodes_.find(end);
-    if (!edge.pruned) --node->second.unpruned;
-    if (--node->second.present == 0) nodes_.erase(node);
+    Node& node = nodes_[static_cast<size_t>(end)];
+    if (!edge.pruned) --node.unpruned;
+    if (--node.present == 0) node = Node{};
   }
   edge = GraphEdge{};
   edge.a = edge.b = kNoPoint;
   edge.pruned = true;
-  ranking_weight_[index] = -1.0;
   free_edges_.push_back(index);
 }
 
@@ -138,13 +155,14 @@ void DeformationGraph::Retire(const std::vector<PointId>& live, size_t point_cou
     newly_retired.push_back(static_cast<PointId>(id));
   }
   for (const PointId id : newly_retired) {
-    const auto node = nodes_.find(id);
-    if (node == nodes_.end()) continue;
-    // Nothing reads a retired point's list again: it goes now, and the counts stay for the
+    if (!FindNode(id)) continue;
+    // Nothing reads a retired point's lists again: they go now, and the counts stay for the
     // edges to live points. Its entries are all present (an edge is erased only once both
     // ends are retired), except those erased just now from a point retired beside it.
-    const std::vector<Incidence> incidences = std::move(node->second.edges);
-    node->second.edges = {};
+    Node& node = nodes_[static_cast<size_t>(id)];
+    const std::vector<Incidence> incidences = std::move(node.edges);
+    node.edges = {};
+    node.ranking = {};
     for (const Incidence& incidence : incidences) {
       if (edges_[incidence.edge].a != kNoPoint && IsRetired(incidence.other)) EraseEdge(incidence.edge);
     }
@@ -208,26 +226,30 @@ void DeformationGraph::UpdatePoints(const std::vector<PointId>& points, const Po
   CheckLive(points);
   const ListPositions listed(points);
   // The edges in storage order, one pass over memory rather than a jump per neighbour (a
-  // complete graph gives each point hundreds), and each point's position looked up once.
-  std::vector<std::optional<Eigen::Vector3d>> known(listed.size());
-  std::vector<bool> looked_up(listed.size(), false);
-  const auto located = [&](PointId id) {
+  // complete graph gives each point hundreds), and each point's position looked up once
+  // (every end of an edge has a node, so the tables need no growing).
+  enum Lookup : uint8_t { kNotYet, kFound, kNone };
+  std::vector<Lookup> lookup(nodes_.size(), kNotYet);
+  std::vector<Eigen::Vector3d> found(nodes_.size());
+  const auto locate = [&](PointId id) -> const Eigen::Vector3d* {
     const auto slot = static_cast<size_t>(id);
-    if (slot >= known.size()) {
-      known.resize(slot + 1);
-      looked_up.resize(slot + 1, false);
+    if (lookup[slot] == kNotYet) {
+      const std::optional<Eigen::Vector3d> p = position(id);
+      lookup[slot] = p ? kFound : kNone;
+      if (p) found[slot] = *p;
     }
-    if (!looked_up[slot]) {
-      known[slot] = position(id);
-      looked_up[slot] = true;
-    }
-    return known[slot];
+    return lookup[slot] == kFound ? &found[slot] : nullptr;
   };
   for (size_t index = 0; index < edges_.size(); ++index) {
     const GraphEdge& edge = edges_[index];
     if (edge.a == kNoPoint || !(listed.Contains(edge.a) || listed.Contains(edge.b))) continue;
-    const std::optional<Eigen::Vector3d> here = located(edge.a), there = located(edge.b);
-    if (here && there) Remeasure(static_cast<int>(index), (*here - *there).norm());
+    const Eigen::Vector3d* here = locate(edge.a);
+    const Eigen::Vector3d* there = here ? locate(edge.b) : nullptr;
+    if (!there) continue;
+    // Most lengths fall between the two bounds, and then nothing changes: the pruning test
+    // was made when the bounds last moved.
+    const double length = (*here - *there).norm();
+    if (length < edge.min_length || length > edge.max_length) Remeasure(static_cast<int>(index), length);
   }
 }
 
@@ -235,10 +257,10 @@ void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const 
   CheckLive(points);
   const std::unordered_set<PointId> chosen(points.begin(), points.end());
   for (PointId point : points) {
-    const auto node = nodes_.find(point);
+    const Node* node = FindNode(point);
     const auto here = position(point);
-    if (node == nodes_.end() || !here) continue;
-    for (const auto& [other, index] : node->second.edges) {
+    if (!node || !here) continue;
+    for (const auto& [other, index] : node->edges) {
       if (other < point && chosen.count(other)) continue;  // done from the other end
       if (!chosen.count(other)) continue;
       const auto there = position(other);
@@ -255,8 +277,8 @@ void DeformationGraph::ResetRestShape(const std::vector<PointId>& points, const 
 template <typename Eligible>
 void DeformationGraph::SelectBest(PointId point, const Eligible& eligible, std::vector<GraphNeighbour>* best) const {
   best->clear();
-  const auto node = nodes_.find(point);
-  if (node == nodes_.end()) return;
+  const Node* node = FindNode(point);
+  if (!node) return;
   // The best D so far, best first: highest b, ties broken by id so the choice never depends
   // on insertion order. A complete graph gives a point hundreds of edges of which D are kept,
   // so an edge that would not enter is set aside before `eligible` is asked about it.
@@ -265,15 +287,23 @@ void DeformationGraph::SelectBest(PointId point, const Eligible& eligible, std::
   };
   const auto degree = static_cast<size_t>(options_.max_degree_D);
   best->reserve(degree);  // one allocation per list, not one per doubling (a list per lost point per frame)
-  for (const auto& [other, index] : node->second.edges) {
-    const double weight = ranking_weight_[index];
-    if (weight < 0.0) continue;
+  const double* ranking = node->ranking.data();
+  const Incidence* incidences = node->edges.data();
+  const size_t count = node->edges.size();
+  // Below `entry` an edge can be set aside on its weight alone, which is what nearly all are:
+  // the loop then reads one array (b ≥ 0 always, so −1 marks what may not regularise).
+  double entry = 0.0;
+  for (size_t slot = 0; slot < count; ++slot) {
+    const double weight = ranking[slot];
+    if (weight < entry) continue;
+    const auto& [other, index] = incidences[slot];
     if (best->size() == degree && !better(weight, other, best->back())) continue;
     if (!eligible(other)) continue;
     if (best->size() == degree) best->pop_back();
-    auto slot = best->end();
-    while (slot != best->begin() && better(weight, other, *(slot - 1))) --slot;
-    best->insert(slot, {other, index, weight});
+    auto place = best->end();
+    while (place != best->begin() && better(weight, other, *(place - 1))) --place;
+    best->insert(place, {other, index, weight});
+    if (best->size() == degree) entry = best->back().weight;
   }
 }
 
@@ -316,8 +346,8 @@ std::vector<GraphPair> DeformationGraph::PairsAmong(const std::vector<PointId>& 
 
 int DeformationGraph::GoodEdgeCount(PointId point) const {
   CheckLive(point);
-  const auto node = nodes_.find(point);
-  return node == nodes_.end() ? 0 : node->second.unpruned;
+  const Node* node = FindNode(point);
+  return node ? node->unpruned : 0;
 }
 
 size_t DeformationGraph::pruned_count() const {

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -114,27 +115,32 @@ class DeformationGraph {
     int edge;
   };
   struct Node {
-    // A retired node's list may still name edges erased since (never read again); `present`
-    // counts the ones that are not, and the node goes when it reaches 0.
+    // Append-only while the point is live, so an edge keeps its slot in both ends' lists; a
+    // retired point's lists are emptied (nothing reads them again).
     std::vector<Incidence> edges;
+    // Per slot, the edge's b if it may regularise (unpruned, b >= min_edge_weight), else −1:
+    // what the best-D choice reads, kept beside the point's list because a complete graph gives
+    // every point hundreds of edges, the choice is made for every point every frame, and only a
+    // few of the weights change in a frame.
+    std::vector<double> ranking;
     int unpruned = 0;
-    int present = 0;
+    int present = 0;  // edges not erased; the node's storage goes when it reaches 0
   };
-  std::vector<GraphEdge> edges_;  // a free slot has a == kNoPoint
+  std::vector<GraphEdge> edges_;           // a free slot has a == kNoPoint
+  std::vector<std::array<int, 2>> slots_;  // per edge, its slot in the lists of a and of b
   std::vector<int> free_edges_;
-  std::vector<bool> retired_;     // by point id
-  // Per edge, b if it may regularise (unpruned, b >= min_edge_weight), else −1: what the
-  // best-D choice reads for each of a point's edges, packed densely because a complete graph
-  // gives every point hundreds of them and the choice is made for every point every frame.
-  std::vector<double> ranking_weight_;
-  std::unordered_map<PointId, Node> nodes_;
+  std::vector<bool> retired_;  // by point id
+  std::vector<Node> nodes_;    // by point id
   std::unordered_map<uint64_t, int> edge_index_;  // keyed by the unordered pair
 
   double WeightOf(double max_length) const;
   template <typename Eligible>
   void SelectBest(PointId point, const Eligible& eligible, std::vector<GraphNeighbour>* best) const;
-  void Remeasure(int index, double length);  // a new observed length: d_min, d_max, b, pruning
-  void UpdateRanking(int index);
+  // A length outside [d_min, d_max]: the bounds, b, pruning and the ranking follow it.
+  void Remeasure(int index, double length);
+  void UpdateRanking(int index);  // copies the edge's ranking weight into both ends' lists
+  double RankingWeight(const GraphEdge& edge) const;
+  const Node* FindNode(PointId point) const;
   void EraseEdge(int index);
   // Throws unless every point may still be read (none is retired).
   void CheckLive(const std::vector<PointId>& points) const;
