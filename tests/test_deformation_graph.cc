@@ -223,6 +223,20 @@ TEST(DeformationGraph, ResettingTheRestShapeTouchesOnlyEdgesAmongTheGivenPoints)
   EXPECT_DOUBLE_EQ(graph.edge(*graph.FindEdge(2, 3)).rest_length, std::sqrt(5.0));
 }
 
+// Ids are map indices: a negative one or one beyond 2³¹ is refused when an edge is made and
+// finds no edge, rather than aliasing another pair.
+TEST(DeformationGraph, IdsOutsideTheMapIndexRangeAreRefused) {
+  DeformationModelOptions options;
+  DeformationGraph graph(options, 1.0);
+  graph.AddEdge(1, 2, 0.5);
+  EXPECT_THROW(graph.AddEdge(-3, 2, 0.5), Error);
+  EXPECT_THROW(graph.AddEdge(1, PointId{1} << 31, 0.5), Error);
+  EXPECT_TRUE(graph.FindEdge(2, 1));
+  EXPECT_FALSE(graph.FindEdge(2, 1 + (PointId{1} << 32)));
+  EXPECT_FALSE(graph.FindEdge(-1, 2));
+  EXPECT_EQ(graph.edge_count(), 1u);
+}
+
 TEST(DeformationGraph, FlagsPointsLeftWithTooFewEdges) {
   DeformationModelOptions options;
   options.min_good_edges = 2;

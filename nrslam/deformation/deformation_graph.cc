@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "nrslam/util/error.h"
@@ -63,30 +64,30 @@ double DeformationGraph::WeightOf(double max_length) const {
   return std::exp(-max_length * max_length / (2.0 * sigma_ * sigma_));
 }
 
+bool DeformationGraph::IsGraphId(PointId point) {
+  return point >= 0 && point <= std::numeric_limits<int32_t>::max();
+}
+
 uint64_t DeformationGraph::PairKey(PointId a, PointId b) {
+  // Both ids below 2³¹: the key names one pair only.
   const auto low = static_cast<uint64_t>(std::min(a, b)), high = static_cast<uint64_t>(std::max(a, b));
-  return (high << 32) ^ low ^ (high >> 32);
+  return (high << 32) | low;
 }
 
 std::optional<int> DeformationGraph::FindEdge(PointId a, PointId b) const {
-  const auto candidates = edge_index_.find(PairKey(a, b));
-  if (candidates == edge_index_.end()) return std::nullopt;
-  const GraphEdge& edge = edges_[candidates->second];
-  if ((edge.a == a && edge.b == b) || (edge.a == b && edge.b == a)) return candidates->second;
-  // A key collision (only possible for ids beyond 2³²): fall back to the adjacency list.
-  const Node* node = FindNode(a);
-  if (!node) return std::nullopt;
-  for (const Incidence& incidence : node->edges) {
-    const GraphEdge& candidate = edges_[incidence.edge];
-    if (incidence.other == b && (candidate.a == b || candidate.b == b)) return incidence.edge;
-  }
-  return std::nullopt;
+  if (!IsGraphId(a) || !IsGraphId(b)) return std::nullopt;
+  const auto found = edge_index_.find(PairKey(a, b));
+  if (found == edge_index_.end()) return std::nullopt;
+  return found->second;
 }
 
 void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
   CheckLive(a);
   CheckLive(b);
-  if (a < 0 || b < 0) throw Error("deformation graph: point ids are map indices, got a negative one");
+  if (!IsGraphId(a) || !IsGraphId(b)) {
+    throw Error("deformation graph: point ids are map indices below 2^31, got " + std::to_string(a) + " and " +
+                std::to_string(b));
+  }
   if (a == b || FindEdge(a, b)) return;
   if (!(length > 0) || !std::isfinite(length)) return;  // coincident or invalid points: no direction to regularise
   const GraphEdge edge{a, b, length, length, length, WeightOf(length), false};
@@ -105,7 +106,7 @@ void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
   for (const auto& [from, to] : {std::pair(a, b), std::pair(b, a)}) {
     Node& node = nodes_[static_cast<size_t>(from)];
     slots_[index][end++] = static_cast<int>(node.edges.size());
-    node.edges.push_back({to, index});
+    node.edges.push_back({static_cast<int32_t>(to), index});
     node.ranking.push_back(RankingWeight(edge));
     ++node.unpruned;
     ++node.present;
@@ -115,8 +116,7 @@ void DeformationGraph::AddEdge(PointId a, PointId b, double length) {
 
 void DeformationGraph::EraseEdge(int index) {
   GraphEdge& edge = edges_[index];
-  const auto key = edge_index_.find(PairKey(edge.a, edge.b));
-  if (key != edge_index_.end() && key->second == index) edge_index_.erase(key);
+  edge_index_.erase(PairKey(edge.a, edge.b));
   for (const PointId end : {edge.a, edge.b}) {
     Node& node = nodes_[static_cast<size_t>(end)];
     if (!edge.pruned) --node.unpruned;

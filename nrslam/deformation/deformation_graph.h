@@ -111,7 +111,7 @@ class DeformationGraph {
   DeformationModelOptions options_;
   double sigma_;
   struct Incidence {
-    PointId other;
+    int32_t other;  // ids are below 2³¹ (AddEdge checks): half the memory of a PointId
     int edge;
   };
   struct Node {
@@ -145,6 +145,7 @@ class DeformationGraph {
   // Throws unless every point may still be read (none is retired).
   void CheckLive(const std::vector<PointId>& points) const;
   void CheckLive(PointId point) const;
+  static bool IsGraphId(PointId point);  // a map index below 2³¹
   static uint64_t PairKey(PointId a, PointId b);
 };
 
