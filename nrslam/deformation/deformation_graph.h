@@ -62,7 +62,8 @@ class DeformationGraph {
   // Sets σ (map units) and recomputes every weight.
   void set_sigma(double sigma);
 
-  // Adds the edge a–b with the given current length; no-op if it exists or a == b.
+  // Adds the edge a–b with the given current length; no-op if it exists or a == b. Ids are map
+  // indices below 2³¹: any other throws.
   void AddEdge(PointId a, PointId b, double length);
   // Joins each new point to every other new point and to every existing point that has a
   // position: the points co-visible at creation.
