@@ -10,6 +10,7 @@
 //   bench_tracking [FRAMES=60] [PRESET ...=sim-0 sim-3 sim-6] [--repeat N=1] [--set module.option=value ...]
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <string>
@@ -29,7 +30,8 @@ const std::array<const char*, 4> kModes = {"deformable", "no-ahead", "cgnr", "ri
 
 // One mode's run over a preset: frames timed and, per timed frame, mean ms per stage.
 struct ModeRun {
-  double tracked = 0, fps = 0, klt = 0, ahead = 0, pose = 0, deformation = 0, solve = 0, linear = 0, total = 0, points = 0;
+  double tracked = 0, fps = 0;
+  double klt = 0, ahead = 0, pose = 0, deformation = 0, solve = 0, linear = 0, total = 0, points = 0;
 };
 
 ModeRun TimeMode(const std::string& mode, const nrslam::SystemOptions& options, const nrslam::Renderer& renderer,
@@ -122,10 +124,11 @@ int main(int argc, char** argv) {
                     *std::max_element(fps.begin(), fps.end()));
       std::printf("%-9s %-10s %7.0f %7.1f %11s %7.2f %8.2f %8.2f %8.2f %9.2f %8.2f %9.2f %8.2f %8.0f\n",
                   preset.c_str(), kModes[m], MedianOf(runs[m], &ModeRun::tracked), nrslam::Median(fps), range,
-                  nrslam::Median(versus_deformable), MedianOf(runs[m], &ModeRun::klt), MedianOf(runs[m], &ModeRun::ahead),
-                  MedianOf(runs[m], &ModeRun::pose), MedianOf(runs[m], &ModeRun::deformation),
-                  MedianOf(runs[m], &ModeRun::solve), MedianOf(runs[m], &ModeRun::linear),
-                  MedianOf(runs[m], &ModeRun::total), MedianOf(runs[m], &ModeRun::points));
+                  nrslam::Median(versus_deformable), MedianOf(runs[m], &ModeRun::klt),
+                  MedianOf(runs[m], &ModeRun::ahead), MedianOf(runs[m], &ModeRun::pose),
+                  MedianOf(runs[m], &ModeRun::deformation), MedianOf(runs[m], &ModeRun::solve),
+                  MedianOf(runs[m], &ModeRun::linear), MedianOf(runs[m], &ModeRun::total),
+                  MedianOf(runs[m], &ModeRun::points));
     }
   }
   return 0;

@@ -263,7 +263,9 @@ void ExpectCountsAndBestEdgesFromTheRecords(const DeformationGraph& graph, const
     const GraphEdge& edge = graph.edge(e);
     if (edge.a != id && edge.b != id) continue;
     if (!edge.pruned) ++unpruned;
-    if (!edge.pruned && edge.weight >= options.min_edge_weight) usable.emplace_back(-edge.weight, edge.a == id ? edge.b : edge.a);
+    if (!edge.pruned && edge.weight >= options.min_edge_weight) {
+      usable.emplace_back(-edge.weight, edge.a == id ? edge.b : edge.a);
+    }
   }
   EXPECT_EQ(graph.GoodEdgeCount(id), unpruned) << "point " << id;
   std::sort(usable.begin(), usable.end());
