@@ -177,55 +177,6 @@ TEST_F(KltOnWarps, FlatAndNoiseFramesConfirmNoTrack) {
   EXPECT_EQ(tracked_into(*reference_, gated), static_cast<long>(points_->size()));
 }
 
-// Copies of reference patches track exactly as the patches they copy: assembled in another
-// order, mixed with patches cut afresh, under a mask that leaves some points without a patch.
-TEST_F(KltOnWarps, CopiedReferencePatchesTrackAsTheOriginals) {
-  const KltOptions options;
-  const ImagePyramid reference(*reference_, options.levels);
-  cv::Mat valid(reference_->size(), CV_8UC1, cv::Scalar(255));
-  valid(cv::Rect(0, 0, valid.cols / 3, valid.rows)).setTo(0);
-  KltTracker whole(options);
-  whole.SetReference(reference, *points_, valid);
-  const std::vector<cv::Point2f> reversed(points_->rbegin(), points_->rend());
-  KltTracker source(options);
-  source.SetReference(reference, reversed, valid);
-  KltTracker assembled(options);
-  const size_t n = points_->size();
-  for (size_t i = 0; i < n; ++i) {
-    if (i % 2 == 0) {
-      assembled.AppendCopies(source, {n - 1 - i});
-    } else {
-      assembled.Append(reference, {(*points_)[i]}, valid);
-    }
-  }
-  ASSERT_EQ(assembled.size(), n);
-  cv::Mat current;
-  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 3.3, 0, 1, -2.1);
-  cv::warpAffine(*reference_, current, shift, reference_->size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
-  const ImagePyramid pyramid(current, options.levels);
-  std::vector<KltResult> expected, got;
-  whole.Track(pyramid, *points_, options.ssim_tracking, &expected);
-  assembled.Track(pyramid, *points_, options.ssim_tracking, &got);
-  int tracked = 0, without_patch = 0;
-  for (size_t i = 0; i < n; ++i) {
-    EXPECT_EQ(assembled.has_reference(i), whole.has_reference(i)) << i;
-    EXPECT_EQ(got[i].status, expected[i].status) << i;
-    EXPECT_EQ(got[i].position.x, expected[i].position.x) << i;
-    EXPECT_EQ(got[i].position.y, expected[i].position.y) << i;
-    EXPECT_EQ(got[i].ssim, expected[i].ssim) << i;
-    tracked += expected[i].status == KltStatus::kTracked;
-    without_patch += !whole.has_reference(i);
-  }
-  EXPECT_GT(tracked, static_cast<int>(n) / 2);
-  EXPECT_GT(without_patch, 0);
-  EXPECT_THROW(assembled.AppendCopies(source, {n}), Error);
-  KltOptions fewer_levels = options;
-  fewer_levels.levels = 3;
-  KltTracker other(fewer_levels);
-  other.SetReference(ImagePyramid(*reference_, fewer_levels.levels), *points_);
-  EXPECT_THROW(assembled.AppendCopies(other, {0}), Error);
-}
-
 TEST(Klt, RejectsBadInputCleanly) {
   const cv::Mat flat(120, 160, CV_8UC1, cv::Scalar(90));
   KltTracker tracker{KltOptions{}};

@@ -380,32 +380,6 @@ void KltTracker::Append(const ImagePyramid& reference, const std::vector<cv::Poi
   }
 }
 
-void KltTracker::AppendCopies(const KltTracker& source, const std::vector<size_t>& indices) {
-  if (points_.empty()) levels_ = source.levels_;
-  if (source.levels_ != levels_ || source.window_ != window_) {
-    throw Error("KltTracker::AppendCopies: the source has " + std::to_string(source.levels_) + " levels and " +
-                std::to_string(source.window_) + " px windows, this tracker " + std::to_string(levels_) + " and " +
-                std::to_string(window_));
-  }
-  const auto copy_slice = [](const auto& from, auto* to, size_t index, size_t per_point) {
-    to->insert(to->end(), from.begin() + static_cast<std::ptrdiff_t>(index * per_point),
-               from.begin() + static_cast<std::ptrdiff_t>((index + 1) * per_point));
-  };
-  const auto levels = static_cast<size_t>(levels_), area = static_cast<size_t>(area_);
-  for (const size_t index : indices) {
-    if (index >= source.size()) throw Error("KltTracker::AppendCopies: no reference point " + std::to_string(index));
-    points_.push_back(source.points_[index]);
-    copy_slice(source.patch_, &patch_, index, levels * area);
-    copy_slice(source.gradient_x_, &gradient_x_, index, levels * area);
-    copy_slice(source.gradient_y_, &gradient_y_, index, levels * area);
-    copy_slice(source.inverse_normal_, &inverse_normal_, index, levels * 3);
-    copy_slice(source.level_valid_, &level_valid_, index, levels);
-    copy_slice(source.reference_trend_, &reference_trend_, index, levels);
-    copy_slice(source.affine_normal_, &affine_normal_, index, 36);
-    copy_slice(source.affine_steepest_, &affine_steepest_, index, 6 * area);
-  }
-}
-
 KltResult KltTracker::TrackOne(const ImagePyramid& current, size_t index, const cv::Point2f& guess,
                                double ssim_threshold, float* warped) const {
   // Coarse levels widen the capture range but see more of the light field than of the

@@ -49,12 +49,7 @@ class KltTracker {
   // Adds reference points cut from another image (e.g. a re-found point's patch from the
   // keyframe it was last seen in); indices continue after the existing ones.
   void Append(const ImagePyramid& reference, const std::vector<cv::Point2f>& points, const cv::Mat& valid = {});
-  // Adds copies of `source`'s reference points `indices`, in that order: the same patches as
-  // cutting them again from the image they were cut in, without the work. `source` must have
-  // the same options and as many levels.
-  void AppendCopies(const KltTracker& source, const std::vector<size_t>& indices);
   size_t size() const { return points_.size(); }
-  const cv::Point2f& point(size_t index) const { return points_[index]; }
   bool has_reference(size_t index) const { return level_valid_[index * levels_]; }
 
   // Tracks every reference point into `current`, starting from guesses[i] (level-0 px).

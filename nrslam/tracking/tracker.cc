@@ -170,7 +170,7 @@ void Tracker::PromoteCandidate(int track_id, PointId id) {
 }
 
 void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid,
-                               const cv::Mat& grey, const PreparedReference* prepared) {
+                               const cv::Mat& grey) {
   std::vector<PointTrack> active;
   std::vector<cv::Point2f> pixels;
   for (const PointTrack& track : tracks_) {
@@ -190,35 +190,7 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
     }
   }
   tracks_ = std::move(active);
-  if (prepared) {
-    // Patches are cut point by point, so copies and fresh cuts, batched in runs in the tracks'
-    // order, give the reference SetReference would.
-    std::unordered_map<int, size_t> slot_of;
-    for (size_t k = 0; k < prepared->track_ids.size(); ++k) slot_of.emplace(prepared->track_ids[k], k);
-    KltTracker klt(frontend_.klt);
-    std::vector<size_t> copies;
-    std::vector<cv::Point2f> cuts;
-    const auto flush = [&] {
-      klt.AppendCopies(prepared->klt, copies);
-      klt.Append(*keyframe, cuts, valid);
-      copies.clear();
-      cuts.clear();
-    };
-    for (const PointTrack& track : tracks_) {
-      const auto found = slot_of.find(track.track_id);
-      const bool copied = found != slot_of.end() && prepared->klt.point(found->second) == track.pixel;
-      if (copied && !cuts.empty()) flush();
-      if (copied) {
-        copies.push_back(found->second);
-      } else {
-        cuts.push_back(track.pixel);
-      }
-    }
-    flush();
-    klt_ = std::move(klt);
-  } else {
-    klt_.SetReference(*keyframe, pixels, valid);
-  }
+  klt_.SetReference(*keyframe, pixels, valid);
   ++reference_generation_;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (klt_.has_reference(i)) {
@@ -228,18 +200,6 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
     }
   }
   frames_since_keyframe_ = 0;
-}
-
-Tracker::PreparedReference Tracker::PrepareReference(const ImagePyramid& keyframe, const cv::Mat& valid) const {
-  PreparedReference prepared{KltTracker(frontend_.klt), {}};
-  std::vector<cv::Point2f> pixels;
-  for (const PointTrack& track : tracks_) {
-    if (!track.active) continue;
-    prepared.track_ids.push_back(track.track_id);
-    pixels.push_back(track.pixel);
-  }
-  prepared.klt.SetReference(keyframe, pixels, valid);
-  return prepared;
 }
 
 void Tracker::RetireDroppedPoints(std::vector<PointId> in_use) {
@@ -508,8 +468,8 @@ Tracker::Lookahead Tracker::RunAhead(const cv::Mat& next_bgr, const std::vector<
   Lookahead ahead;
   ahead.grey = ToGrey(next_bgr);
   ahead.pyramid = std::make_shared<const ImagePyramid>(ahead.grey, frontend_.klt.levels);
-  // One thread: the other core is this frame's solve. No guesses: the pyramid alone.
-  if (!guesses.empty()) klt_.Track(*ahead.pyramid, guesses, frontend_.klt.ssim_tracking, &ahead.matches, 1);
+  // One thread: the other core is this frame's solve.
+  klt_.Track(*ahead.pyramid, guesses, frontend_.klt.ssim_tracking, &ahead.matches, 1);
   ahead.reference_generation = reference_generation;
   ahead.ms = MillisecondsSince(start);
   return ahead;
@@ -629,23 +589,19 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     return Lost(result, "only " + std::to_string(observations.size()) + " points tracked");
   }
 
-  // Pose and deformation; beside them, on the other core, this frame's validity mask, which
-  // re-association will most likely need, and the next frame's pyramid and KLT from the tracks
-  // as they are now. On a frame that will refresh the reference, that KLT could not serve:
-  // the other core cuts the tracks' new reference patches instead.
+  // Pose and deformation; beside them, on the other core, the next frame's pyramid and KLT
+  // from the tracks as they are now, and this frame's validity mask, which re-association will
+  // most likely need. (On a frame that refreshes the reference only the pyramid will serve.)
   FrameSolution solution;
   std::optional<std::string> lost;
   const auto solve = [&] { lost = SolvePoseAndDeformation(&observations, &solution, &result); };
   cv::Mat valid;
-  const bool refresh_due = frames_since_keyframe_ + 1 >= options_.keyframe_period;
-  std::optional<PreparedReference> prepared;
   // Not in rigid mode: its pose-only solve is shorter than the KLT on one core, which it would wait for.
   if (options_.klt_lookahead && !options_.rigid && !next_bgr.empty()) {
     Lookahead next;
-    const auto run_ahead = [&, guesses = refresh_due ? std::vector<cv::Point2f>{} : KltGuesses()] {
-      valid = BuildValidityMask(grey, mask, frontend_.masks);
-      if (refresh_due) prepared = PrepareReference(*pyramid, valid);
+    const auto run_ahead = [&, guesses = KltGuesses()] {
       next = RunAhead(next_bgr, guesses, reference_generation_);
+      valid = BuildValidityMask(grey, mask, frontend_.masks);
     };
     RunConcurrently(run_ahead, solve);
     lookahead_ = std::move(next);
@@ -676,14 +632,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   cam_from_world_ = pose;
   ForgetLostPoints(frame);
   // One validity mask per frame, shared by re-association and a reference refresh.
+  const bool refresh = frames_since_keyframe_ + 1 >= options_.keyframe_period;
   const bool search = options_.reassociation && !lost_.empty();
-  if ((search || refresh_due) && valid.empty()) valid = BuildValidityMask(grey, mask, frontend_.masks);
+  if ((search || refresh) && valid.empty()) valid = BuildValidityMask(grey, mask, frontend_.masks);
   if (search) Reassociate(*pyramid, valid, &result);
   if (static_cast<int>(result.points.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");
   }
   if (++frames_since_keyframe_ >= options_.keyframe_period) {
-    RefreshReference(frame, pyramid, valid, grey, prepared ? &*prepared : nullptr);
+    RefreshReference(frame, pyramid, valid, grey);
     result.keyframe = true;
     result.candidates.clear();  // the refresh may have dropped some and added new ones
     for (const PointTrack& track : tracks_) {

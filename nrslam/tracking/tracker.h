@@ -143,12 +143,6 @@ class Tracker {
     int reference_generation = 0;        // the KLT reference it tracked against
     double ms = 0;
   };
-  // Reference patches cut in a frame, while it was being solved, at the tracks active then
-  // (their track ids, in order): what that frame's reference refresh will mostly re-cut.
-  struct PreparedReference {
-    KltTracker klt;
-    std::vector<int> track_ids;
-  };
 
   Camera camera_;
   FrontendOptions frontend_;
@@ -172,11 +166,8 @@ class Tracker {
 
   // Cuts new reference patches in `keyframe`; `valid` is its validity mask. With candidates
   // on and a grey image given, new corners away from every track join as candidates.
-  // A track that `prepared` (cut in the same keyframe with the same mask) has at its pixel
-  // takes a copy of that patch.
   void RefreshReference(int frame, std::shared_ptr<const ImagePyramid> keyframe, const cv::Mat& valid,
-                        const cv::Mat& grey = {}, const PreparedReference* prepared = nullptr);
-  PreparedReference PrepareReference(const ImagePyramid& keyframe, const cv::Mat& valid) const;
+                        const cv::Mat& grey = {});
   // Where the KLT starts each track in the next image: its last pixel, NaN when inactive.
   std::vector<cv::Point2f> KltGuesses() const;
   // The short-term KLT of every track into `pyramid` from `guesses`, re-using the results of
