@@ -22,7 +22,7 @@ constexpr double kSigma = 1.5;
 
 class DeformingGraph {
  public:
-  DeformingGraph() : graph_(nrslam::DeformationModelOptions{}, kSigma), rest_(kPoints), now_(kPoints) {
+  DeformingGraph() : graph(nrslam::DeformationModelOptions{}, kSigma), rest_(kPoints), now_(kPoints) {
     std::mt19937 random(7);
     std::normal_distribution<double> normal;
     for (auto& p : rest_) p = Eigen::Vector3d(normal(random), normal(random), 0.3 * normal(random));
@@ -30,9 +30,9 @@ class DeformingGraph {
     std::vector<PointId> all;
     for (PointId id = 0; id < kPoints; ++id) {
       all.push_back(id);
-      ((id % kTrackedEvery) < 3 ? tracked_ : lost_).push_back(id);
+      ((id % kTrackedEvery) < 3 ? tracked : lost).push_back(id);
     }
-    graph_.ConnectCovisible(all, {}, Lookup());
+    graph.ConnectCovisible(all, {}, Lookup());
   }
 
   // The surface one frame on: a travelling wave across it plus a little noise.
@@ -49,8 +49,8 @@ class DeformingGraph {
   }
   bool IsTracked(PointId id) const { return (id % kTrackedEvery) < 3; }
 
-  nrslam::DeformationGraph graph_;
-  std::vector<PointId> tracked_, lost_;
+  nrslam::DeformationGraph graph;
+  std::vector<PointId> tracked, lost;
 
  private:
   std::vector<Eigen::Vector3d> rest_, now_;
@@ -65,10 +65,10 @@ void BM_GraphRemeasureTrackedEdges(benchmark::State& state) {
     state.PauseTiming();
     scene.Advance();
     state.ResumeTiming();
-    scene.graph_.UpdatePoints(scene.tracked_, scene.Lookup());
+    scene.graph.UpdatePoints(scene.tracked, scene.Lookup());
   }
-  state.counters["edges"] = static_cast<double>(scene.graph_.edge_count());
-  state.counters["pruned"] = static_cast<double>(scene.graph_.pruned_count());
+  state.counters["edges"] = static_cast<double>(scene.graph.edge_count());
+  state.counters["pruned"] = static_cast<double>(scene.graph.pruned_count());
 }
 
 void BM_GraphPairsAmongTracked(benchmark::State& state) {
@@ -77,9 +77,9 @@ void BM_GraphPairsAmongTracked(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
     scene.Advance();
-    scene.graph_.UpdatePoints(scene.tracked_, scene.Lookup());
+    scene.graph.UpdatePoints(scene.tracked, scene.Lookup());
     state.ResumeTiming();
-    pairs = scene.graph_.PairsAmong(scene.tracked_).size();
+    pairs = scene.graph.PairsAmong(scene.tracked).size();
     benchmark::DoNotOptimize(pairs);
   }
   state.counters["pairs"] = static_cast<double>(pairs);
@@ -87,15 +87,15 @@ void BM_GraphPairsAmongTracked(benchmark::State& state) {
 
 void BM_GraphBestTrackedNeighboursOfLost(benchmark::State& state) {
   DeformingGraph scene;
-  const std::function<bool(PointId)> tracked = [&](PointId id) { return scene.IsTracked(id); };
+  const std::function<bool(PointId)> is_tracked = [&](PointId id) { return scene.IsTracked(id); };
   for (auto _ : state) {
     state.PauseTiming();
     scene.Advance();
-    scene.graph_.UpdatePoints(scene.tracked_, scene.Lookup());
+    scene.graph.UpdatePoints(scene.tracked, scene.Lookup());
     state.ResumeTiming();
-    for (const PointId id : scene.lost_) benchmark::DoNotOptimize(scene.graph_.BestNeighbours(id, tracked).data());
+    for (const PointId id : scene.lost) benchmark::DoNotOptimize(scene.graph.BestNeighbours(id, is_tracked).data());
   }
-  state.counters["lost"] = static_cast<double>(scene.lost_.size());
+  state.counters["lost"] = static_cast<double>(scene.lost.size());
 }
 
 }  // namespace
