@@ -564,11 +564,12 @@ TEST(Results, WhereAndWhyARunStoppedIsShownAndKept) {
   EXPECT_TRUE(ToJson({fine})["results"][0]["stop_reason"].is_null());
 }
 
-TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesAreShownAndKept) {
+TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept) {
   RunResult damaged = Result("sim-2", 0.5, 60);
   damaged.frames_evaluated = 58;
   damaged.frames_unreadable = 1;
   damaged.frames_groundtruth_unreadable = 2;
+  damaged.frames_dropout = 3;
   const RunResult fine = Result("sim-0", 0.1, 60);
   std::stringstream table;
   PrintResults({damaged, fine}, table);
@@ -576,11 +577,15 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesAreShownAndKept) {
                              "(not scored); metrics.csv names the files"),
             std::string::npos)
       << table.str();
+  EXPECT_NE(table.str().find("sim-2: 3 frames skipped as image dropouts (lost; the map kept)"), std::string::npos)
+      << table.str();
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
   const std::vector<RunResult> read = ResultsFromJson(ToJson({damaged, fine}));
   EXPECT_EQ(read[0].frames_unreadable, 1);
   EXPECT_EQ(read[0].frames_groundtruth_unreadable, 2);
   EXPECT_EQ(read[1].frames_groundtruth_unreadable, 0);
+  EXPECT_EQ(read[0].frames_dropout, 3);
+  EXPECT_EQ(read[1].frames_dropout, 0);
 }
 
 // One run of a (k, D) sweep grid, evaluated on 100 frames.

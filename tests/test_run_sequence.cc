@@ -1141,6 +1141,7 @@ TEST(RunSequenceErrors, ASecondMapNumbersItsPointsAfterTheFirst) {
   }
   SystemOptions options = TrackingExperiment();
   options.run.reinitialise_after_loss = true;
+  options.tracking.max_dropout_frames = 0;  // lost on the first black frame, not skipped
   RunSequence(folder, options, folder / "run");
   std::set<int64_t> first_map, second_map;
   for (const auto& row : ReadCsv(folder / "run" / "points.csv")) {
@@ -1156,8 +1157,9 @@ TEST(RunSequenceErrors, ASecondMapNumbersItsPointsAfterTheFirst) {
   fs::remove_all(folder);
 }
 
-// A view that goes black (the light off, the lens covered) loses the track on its first black
-// frame: no patch is matched on a flat image. The summary says where and why.
+// A view that goes black (the light off, the lens covered) for good ends the run lost from its
+// first black frame: no patch is matched on a flat image, and the frames skipped as dropouts
+// before the loss are lost too. The summary says where and why.
 TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {
   const fs::path folder = UniqueTempFolder("nrslam_black_end");
   fs::remove_all(folder);
@@ -1165,15 +1167,96 @@ TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {
   for (int frame = 7; frame < 10; ++frame) {
     cv::imwrite((folder / "rgb" / FrameFileName(frame)).string(), cv::Mat::zeros(240, 320, CV_8UC3));
   }
-  const RunSummary stopped = RunSequence(folder, TrackingExperiment(), folder / "stopped");
+  SystemOptions options = TrackingExperiment();
+  options.tracking.max_dropout_frames = 1;
+  const RunSummary stopped = RunSequence(folder, options, folder / "stopped");
   EXPECT_EQ(stopped.frames_tracked, 7);
+  EXPECT_EQ(stopped.frames_dropout, 1);
   EXPECT_EQ(stopped.Status(), "lost");
   EXPECT_EQ(stopped.stop_frame, 7);
-  EXPECT_NE(stopped.stop_reason.find("points tracked"), std::string::npos) << stopped.stop_reason;
+  EXPECT_NE(stopped.stop_reason.find("points tracked: skipped as an image dropout"), std::string::npos)
+      << stopped.stop_reason;
   const Json written = ReadJsonFile(folder / "stopped" / "summary.json");
   EXPECT_EQ(written.at("status"), "lost");
   EXPECT_EQ(written.at("stop_frame"), 7);
   EXPECT_EQ(written.at("stop_reason"), stopped.stop_reason);
+  EXPECT_EQ(written.at("frames_dropout"), 1);
+  const auto metrics = ReadCsv(folder / "stopped" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 10u);
+  EXPECT_NE(metrics[7].at("note").find("(1 of at most 1 in a row)"), std::string::npos) << metrics[7].at("note");
+  EXPECT_EQ(metrics[8].at("note"), "only 0 points tracked");  // the second black frame: LOST
+  fs::remove_all(folder);
+}
+
+// A few blank frames in the middle of a run (a flush, the lens against the tissue) are skipped
+// with the map kept: tracking picks up where it left off, on the same points, about as accurate
+// as without the gap. Without the skip (the reference), the tracking experiment ends there.
+TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
+  const fs::path folder = *base_ / "dropout";
+  fs::create_directories(folder);
+  fs::copy(*base_ / "sequence", folder / "sequence", fs::copy_options::recursive);
+  const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
+  for (int frame = 15; frame < 18; ++frame) {
+    cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(frame)).string(), grey);
+  }
+
+  const RunSummary skipped = RunSequence(folder / "sequence", TrackingExperiment(), folder / "skipped");
+  EXPECT_EQ(skipped.Status(), "ok");
+  EXPECT_EQ(skipped.maps, 1);
+  EXPECT_EQ(skipped.frames_tracked, 37);
+  EXPECT_EQ(skipped.frames_lost, 3);
+  EXPECT_EQ(skipped.frames_dropout, 3);
+  EXPECT_EQ(skipped.frames_unreadable, 0);
+  EXPECT_NE(DescribeSummary(skipped).find("3 frames skipped as image dropouts (lost; the map kept)"), std::string::npos)
+      << DescribeSummary(skipped);
+  const auto metrics = ReadCsv(folder / "skipped" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 40u);
+  for (int frame = 0; frame < 40; ++frame) {
+    const bool blank = frame >= 15 && frame < 18;
+    EXPECT_EQ(metrics[static_cast<size_t>(frame)].at("state"), blank ? "lost" : "tracking") << frame;
+  }
+  // The points after the gap are the map's from before it.
+  std::set<PointId> before, after;
+  for (const CsvPoint& p : ReadPointsCsv(folder / "skipped" / "points.csv")) {
+    if (p.frame == 14) before.insert(p.id);
+    if (p.frame == 18) after.insert(p.id);
+  }
+  ASSERT_GE(after.size(), 50u);
+  EXPECT_GE(std::count_if(after.begin(), after.end(), [&](PointId id) { return before.count(id) > 0; }),
+            static_cast<std::ptrdiff_t>(after.size() * 9 / 10));
+  EXPECT_LT(skipped.rmse_mm, 1.25 * summary_->rmse_mm) << "without the gap: " << summary_->rmse_mm << " mm";
+
+  SystemOptions reference = TrackingExperiment();
+  reference.tracking.max_dropout_frames = 0;
+  const RunSummary stopped = RunSequence(folder / "sequence", reference, folder / "stopped");
+  EXPECT_EQ(stopped.Status(), "lost");
+  EXPECT_EQ(stopped.stop_frame, 15);
+  EXPECT_EQ(stopped.frames_tracked, 15);
+  EXPECT_EQ(stopped.frames_dropout, 0);
+}
+
+// The same in the full monocular system: the mapper goes on with the map it had, where the
+// reference starts a new one.
+TEST(MonocularRun, AShortImageDropoutKeepsTheMap) {
+  const fs::path folder = UniqueTempFolder("nrslam_monocular_dropout");
+  fs::remove_all(folder);
+  SimulateSmall("sim-1", 40, 320, 240, folder / "sequence");
+  const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
+  for (int frame = 25; frame < 27; ++frame) {
+    cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(frame)).string(), grey);
+  }
+  const RunSummary summary = RunSequence(folder / "sequence", SystemOptions{}, folder / "run");
+  ASSERT_GE(summary.init_frame, 0);
+  EXPECT_LT(summary.init_frame, 25);
+  EXPECT_EQ(summary.Status(), "ok");
+  EXPECT_EQ(summary.maps, 1);
+  EXPECT_EQ(summary.frames_dropout, 2);
+  EXPECT_EQ(summary.frames_tracked, 40 - summary.init_frame - 2);
+  SystemOptions reference;
+  reference.tracking.max_dropout_frames = 0;
+  const RunSummary restarted = RunSequence(folder / "sequence", reference, folder / "reference");
+  EXPECT_EQ(restarted.maps, 2);  // lost on the first blank frame, a new map from the images after
+  EXPECT_EQ(restarted.frames_dropout, 0);
   fs::remove_all(folder);
 }
 

@@ -39,6 +39,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
   result->frames_unreadable = json.value("frames_unreadable", 0);
   result->frames_groundtruth_unreadable = json.value("frames_groundtruth_unreadable", 0);
+  result->frames_dropout = json.value("frames_dropout", 0);
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
   result->rmse_flat_mm = NumberOr(json, "rmse_flat_mm", -1.0);
@@ -282,7 +283,8 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated},
                     {"frames_unreadable", r.frames_unreadable},
-                    {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable}, {"rmse_mm", r.rmse_mm},
+                    {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable},
+                    {"frames_dropout", r.frames_dropout}, {"rmse_mm", r.rmse_mm},
                     {"rmse_median_mm", r.rmse_median_mm},
                     {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
                     {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
@@ -329,13 +331,15 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
-         "frames_unreadable,frames_groundtruth_unreadable,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,"
+         "frames_unreadable,frames_groundtruth_unreadable,frames_dropout,rmse_mm,rmse_median_mm,rmse_flat_mm,"
+         "rmse_map_scale_mm,rmse_median_scale_mm,"
          "ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,"
          "error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
-        << r.frames_unreadable << ',' << r.frames_groundtruth_unreadable << ',' << r.rmse_mm << ',' << r.rmse_median_mm << ','
+        << r.frames_unreadable << ',' << r.frames_groundtruth_unreadable << ',' << r.frames_dropout << ',' << r.rmse_mm
+        << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
@@ -378,6 +382,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     if (!StopText(r).empty()) out << RunKey(r) << ": " << StopText(r) << '\n';
     const std::string unreadable = UnreadableInputText(r.frames_unreadable, r.frames_groundtruth_unreadable);
     if (!unreadable.empty()) out << RunKey(r) << ": " << unreadable << '\n';
+    if (r.frames_dropout > 0) out << RunKey(r) << ": " << DropoutText(r.frames_dropout) << '\n';
   }
   if (!swept) return;
   const std::vector<SweepValueSummary> values = SummariseSweep(results);

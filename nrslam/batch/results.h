@@ -23,6 +23,7 @@ struct RunResult {
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
   int frames_unreadable = 0;              // frames lost because their image could not be read
   int frames_groundtruth_unreadable = 0;  // tracked frames not scored: their ground-truth file was unreadable
+  int frames_dropout = 0;                 // frames lost as image dropouts, the map kept
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   double peak_memory_mb = -1;       // the run process's peak resident memory; negative: not recorded
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none

@@ -32,6 +32,13 @@ std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_un
   return text.empty() ? text : text + "; metrics.csv names the files";
 }
 
+std::string DropoutText(int frames_dropout) {
+  if (frames_dropout == 0) return "";
+  return std::to_string(frames_dropout) +
+         (frames_dropout == 1 ? " frame skipped as an image dropout" : " frames skipped as image dropouts") +
+         " (lost; the map kept)";
+}
+
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
   return stop_frame >= 0 ? "lost" : "ok";
@@ -73,6 +80,7 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (!stop.empty()) text << '\n' << stop;
   const std::string unreadable = UnreadableInputText(summary.frames_unreadable, summary.frames_groundtruth_unreadable);
   if (!unreadable.empty()) text << '\n' << unreadable;
+  if (summary.frames_dropout > 0) text << '\n' << DropoutText(summary.frames_dropout);
   return text.str();
 }
 
@@ -152,6 +160,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_evaluated", summary.frames_evaluated},
                       {"frames_unreadable", summary.frames_unreadable},
                       {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
+                      {"frames_dropout", summary.frames_dropout},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},
                       {"peak_memory_mb", summary.peak_memory_mb > 0 ? nlohmann::json(summary.peak_memory_mb) : nlohmann::json()},

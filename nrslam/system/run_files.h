@@ -37,6 +37,8 @@ struct RunSummary {
   // Frames lost because their colour image or mask could not be read (the run goes on), and
   // tracked frames left unscored because their ground-truth depth file could not be read.
   int frames_unreadable = 0, frames_groundtruth_unreadable = 0;
+  // Frames lost as image dropouts: skipped with the map kept (TrackingOptions::max_dropout_frames).
+  int frames_dropout = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)
   // The process's peak resident memory when the run ended (MB; util/memory_usage.h): the run's
   // own under nrslam_run and nrslam_eval, which give each sequence its own process. 0: not measured.
@@ -66,6 +68,9 @@ std::string DescribeStop(int init_frame, int stop_frame, const std::string& reas
 // What damaged input cost a run, e.g. "1 frame unreadable (lost); ground-truth depth unreadable
 // on 2 tracked frames (not scored); metrics.csv names the files"; "" when nothing.
 std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_unreadable);
+
+// "2 frames skipped as image dropouts (lost; the map kept)"; "" when none.
+std::string DropoutText(int frames_dropout);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked

@@ -184,6 +184,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask, io.PeekNextBgr());
         if (result.state == TrackingState::kLost) {
+          summary.frames_dropout += result.dropout;
           log << "frame " << frame << ": lost (" << result.note << ")\n";
         } else if (options.run.mapping) {
           mapping = mapper.Process(result, bgr, mask, &tracker);

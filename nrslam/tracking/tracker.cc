@@ -147,6 +147,7 @@ FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv:
 
   cam_from_world_ = seed.cam_from_world;
   motion_ = Rigid3();
+  dropouts_in_a_row_ = 0;
   RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels),
                    BuildValidityMask(grey, mask, frontend_.masks));
   state_ = TrackingState::kTracking;
@@ -569,6 +570,27 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   std::vector<KltResult> matches;
   MatchTracks(*pyramid, guesses, matches_ahead ? &*ahead : nullptr, &matches);
   if (ahead) result.ms_klt_ahead = ahead->ms;
+  // An image that matches too few of the map's tracks (blank, saturated, washed out) is skipped
+  // before anything here changes: the next frame starts from where the last tracked one left them.
+  int map_tracks = 0, map_tracks_found = 0;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (!tracks_[i].active || tracks_[i].id == kNoPoint) continue;
+    ++map_tracks;
+    map_tracks_found += matches[i].status == KltStatus::kTracked;
+  }
+  if (map_tracks_found < options_.min_points && dropouts_in_a_row_ < options_.max_dropout_frames) {
+    ++dropouts_in_a_row_;
+    result.state = TrackingState::kLost;
+    result.dropout = true;
+    result.klt_tracked = map_tracks_found;
+    result.note = "only " + std::to_string(map_tracks_found) + " of " + std::to_string(map_tracks) +
+                  " points tracked: skipped as an image dropout, the map kept (" + std::to_string(dropouts_in_a_row_) +
+                  " of at most " + std::to_string(options_.max_dropout_frames) + " in a row)";
+    result.ms_klt = MillisecondsSince(start);
+    result.ms_total = result.ms_klt;
+    return result;
+  }
+  dropouts_in_a_row_ = 0;
   std::vector<Observation> observations;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;

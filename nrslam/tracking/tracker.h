@@ -7,7 +7,8 @@
 // the DDG's best edges → demotion of outliers (‖δ‖ beyond the IQR fence, large reprojection
 // error) → graph update and pruning → the optimised motion propagated to lost and demoted
 // neighbours → mid-term re-association of lost points by a KLT seeded at their projection.
-// Too few points left is the LOST state, a recorded outcome, never an exit.
+// Too few points left is the LOST state, a recorded outcome, never an exit; an image on which
+// the KLT finds too few of them is first skipped as a dropout, a few frames in a row at most.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -62,6 +63,9 @@ struct FrameResult {
   // spent in the linear solver (factorising or CG), which is where deformable tracking's time goes.
   double ms_joint_solve = 0, ms_linear_solve = 0;
   std::string note;                  // why a frame is not tracked
+  // Not tracked, as an image dropout: the tracker kept its map and tracks and will try the next
+  // frame (TrackingOptions::max_dropout_frames); state() is still kTracking.
+  bool dropout = false;
 };
 
 // `motions` less their mean: the part of the points' motion the camera cannot take over. The
@@ -155,6 +159,7 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialised;
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
+  int dropouts_in_a_row_ = 0;  // image dropouts skipped since the last tracked frame
   // By point id: how far the last frame's tracking moved it (with deformation_motion_seed;
   // during the deformation stage, where each point started).
   std::vector<Eigen::Vector3d> point_motion_;

@@ -12,6 +12,12 @@ struct TrackingOptions {
   int max_points = 600;               // map points created at initialisation (strongest corners)
   int keyframe_period = 6;            // KLT reference patches are refreshed every this many frames
   int min_points = 10;                // fewer tracked 3D points: the frame is LOST
+  // An image on which the KLT finds fewer than min_points of the map's tracks (the light off,
+  // the lens against the tissue, a flush or a flash) is skipped with the map kept, up to this
+  // many frames in a row: the next image is tracked from where the last tracked one left the
+  // tracks, with the same constant-velocity seed. One more such frame is LOST. 0: lost at
+  // once, as in the reference.
+  int max_dropout_frames = 5;
   int pose_rounds = 3;                // rigid pose-only refinement: outlier rounds ...
   int pose_iterations = 10;           // ... of this many LM iterations each
   double pose_sigma_px = 1.0;         // σ of the rigid refinement's reprojection residuals
@@ -52,6 +58,7 @@ struct TrackingOptions {
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
+                                                max_dropout_frames,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
                                                 deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
                                                 displacement_prior_sigma, deformation_motion_seed,
