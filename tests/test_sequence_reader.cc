@@ -175,6 +175,12 @@ TEST_F(SequenceReaderTest, MaskNamedButMissing) {
   EXPECT_ERROR_MENTIONS("mask mask.png named by sequence.json is missing");
 }
 
+TEST_F(SequenceReaderTest, MaskWithNoUsablePixel) {
+  cv::imwrite((folder_ / "mask.png").string(), cv::Mat(30, 40, CV_8UC1, cv::Scalar(0)));
+  RewriteJson([](nlohmann::json& j) { j["mask"] = "mask.png"; });
+  EXPECT_ERROR_MENTIONS("mask mask.png marks no pixel usable (all zero; non-zero = usable)");
+}
+
 TEST_F(SequenceReaderTest, ReportsEveryProblemAtOnce) {
   fs::remove(folder_ / "rgb" / "000037.png");
   cv::imwrite((folder_ / "depth" / "000012.png").string(), cv::Mat(15, 20, CV_16UC1, cv::Scalar(100)));

@@ -112,7 +112,12 @@ SequenceReader::SequenceReader(const fs::path& folder) : folder_(folder) {
                          std::to_string(info_.camera.width()) + "x" + std::to_string(info_.camera.height()));
     } else {
       fixed_mask_ = cv::imread((folder / info_.mask).string(), cv::IMREAD_GRAYSCALE);
-      if (fixed_mask_.empty()) problems.push_back("mask " + info_.mask + " cannot be decoded");
+      if (fixed_mask_.empty()) {
+        problems.push_back("mask " + info_.mask + " cannot be decoded");
+      } else if (cv::countNonZero(fixed_mask_) == 0) {
+        // Every frame would then have nothing to track, and the run would say only that.
+        problems.push_back("mask " + info_.mask + " marks no pixel usable (all zero; non-zero = usable)");
+      }
     }
   }
 
