@@ -162,7 +162,14 @@ TEST_F(SequenceReaderTest, GroundtruthLineCount) {
 
 TEST_F(SequenceReaderTest, GroundtruthNaN) {
   std::ofstream(folder_ / "groundtruth.tum") << "0 nan 0 0 0 0 0 1\n";
-  EXPECT_ERROR_MENTIONS("groundtruth.tum:1");
+  EXPECT_ERROR_MENTIONS("groundtruth.tum:1: non-finite value");
+}
+
+TEST_F(SequenceReaderTest, GroundtruthWordsOrTooFewNumbers) {
+  std::ofstream(folder_ / "groundtruth.tum") << "0 1.5mm 0 0 0 0 0 1\n";
+  EXPECT_ERROR_MENTIONS("groundtruth.tum:1: expected 8 numbers");
+  std::ofstream(folder_ / "groundtruth.tum") << "0 0 0 0 0 0 1\n";
+  EXPECT_ERROR_MENTIONS("groundtruth.tum:1: expected 8 numbers");
 }
 
 TEST_F(SequenceReaderTest, StereoWithoutRightImages) {

@@ -1,6 +1,7 @@
 #include "nrslam/io/tum.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -33,7 +34,11 @@ std::vector<StampedPose> ReadTum(const std::filesystem::path& path) {
     std::istringstream fields(line);
     double v[8];
     for (double& value : v) {
-      if (!(fields >> value)) {
+      // strtod, unlike a stream, reads "nan" and "inf": such a pose is then named as non-finite below.
+      std::string token;
+      char* end = nullptr;
+      if (fields >> token) value = std::strtod(token.c_str(), &end);
+      if (end == nullptr || end == token.c_str() || *end != '\0') {
         throw Error(path.string() + ":" + std::to_string(line_number) + ": expected 8 numbers (t tx ty tz qx qy qz qw)");
       }
     }
