@@ -462,6 +462,11 @@ TEST(CameraCheck, RejectsWrongCalibrations) {
   EXPECT_NE(message(Camera::Pinhole(0, 480, 300, 300, 320, 240)).find("image size"), std::string::npos);
   EXPECT_NE(message(Camera::Pinhole(640, 480, 300, 300, 900, 240)).find("principal point"), std::string::npos);
   EXPECT_NE(message(Camera::Pinhole(640, 480, NAN, 300, 320, 240)).find("finite"), std::string::npos);
+  EXPECT_NE(message(Camera::Pinhole(640, 480, 1e12, 1e12, 320, 240)).find("intrinsics of another image size or unit?"),
+            std::string::npos);
+  EXPECT_NE(message(Camera::Pinhole(640, 480, 3000, 300, 320, 240)).find("differ by more than 4 times"),
+            std::string::npos);
+  EXPECT_EQ(message(Camera::Pinhole(720, 288, 800, 400, 360, 144)), "");  // an interlaced field
   EXPECT_NE(message(Camera::KannalaBrandt(640, 480, 300, 300, 320, 240, Eigen::Vector4d(-5, 0, 0, 0))).find("fold"),
             std::string::npos);
   EXPECT_EQ(message(Pinhole()), "");

@@ -270,6 +270,21 @@ void Camera::Check() const {
          << " (must be > 0 px)";
     fail(text.str());
   }
+  // Beyond these, the intrinsics are almost surely of another image size or unit (an endoscope
+  // sees 60-170 degrees; 50 image widths is a view of about 1 degree) or a mistyped number.
+  // Interlaced fields have fy about half of fx. OCam's parameters are not focal lengths.
+  constexpr double kMaxFocalInImageSizes = 50, kMaxPixelAspect = 4;
+  const bool focal_lengths = model_ != CameraModelId::kOcam;
+  if (focal_lengths && (fx() > kMaxFocalInImageSizes * width_ || fy() > kMaxFocalInImageSizes * height_)) {
+    text << "focal length fx=" << fx() << ", fy=" << fy() << " px is over " << kMaxFocalInImageSizes
+         << " times the " << width_ << "x" << height_ << " image (a view of about a degree): intrinsics of another "
+         << "image size or unit?";
+    fail(text.str());
+  }
+  if (focal_lengths && std::max(fx() / fy(), fy() / fx()) > kMaxPixelAspect) {
+    text << "fx=" << fx() << " and fy=" << fy() << " differ by more than " << kMaxPixelAspect << " times";
+    fail(text.str());
+  }
   if (cx() < 0 || cx() > width_ - 1 || cy() < 0 || cy() > height_ - 1) {
     text << "principal point (" << cx() << ", " << cy() << ") lies outside the " << width_ << "x"
          << height_ << " image";
