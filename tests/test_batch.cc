@@ -588,6 +588,24 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_EQ(read[1].frames_dropout, 0);
 }
 
+// A run is "lost" when it leaves frames after its initialisation untracked, or ends without
+// tracking; frames skipped as image dropouts with the map kept are the images' and do not count.
+TEST(Results, StatusFromTheFigures) {
+  RunResult r;
+  r.frames_total = 120;
+  EXPECT_EQ(RunStatus(r), "not_initialised");
+  r.init_frame = 3;
+  r.frames_tracked = 117;
+  EXPECT_EQ(RunStatus(r), "ok");
+  r.frames_tracked = 116;
+  EXPECT_EQ(RunStatus(r), "lost");  // one frame lost on the way (e.g. a new map started after it)
+  r.frames_dropout = 1;
+  EXPECT_EQ(RunStatus(r), "ok");    // that frame was skipped as an image dropout
+  r.stop_frame = 119;
+  r.stop_reason = "only 0 of 180 points tracked: skipped as an image dropout, the map kept (1 of at most 5 in a row)";
+  EXPECT_EQ(RunStatus(r), "lost");  // skipped at the end: the run ends without tracking
+}
+
 // One run of a (k, D) sweep grid, evaluated on 100 frames.
 RunResult GridRun(const std::string& sequence, const std::string& k, const std::string& d, bool lost, double rmse_mm) {
   RunResult r;

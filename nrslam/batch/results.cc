@@ -190,6 +190,12 @@ std::string RmseChangeCounts::ToString() const {
   return std::to_string(better) + " / " + std::to_string(same) + " / " + std::to_string(worse);
 }
 
+std::string RunStatus(const RunResult& figures) {
+  if (figures.init_frame < 0) return "not_initialised";
+  const bool every_frame = figures.init_frame + figures.frames_tracked + figures.frames_dropout >= figures.frames_total;
+  return every_frame && figures.stop_reason.empty() ? "ok" : "lost";
+}
+
 std::string StopText(const RunResult& result) {
   return result.status == "failed" ? "" : DescribeStop(result.init_frame, result.stop_frame, result.stop_reason);
 }
@@ -242,9 +248,7 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan) {
           result.revision = config.value("nrslam_revision", "");
           result.code = config.value("nrslam_code", "");
         }
-        result.status = result.init_frame < 0 ? "not_initialised"
-                        : result.frames_tracked + result.init_frame >= result.frames_total ? "ok"
-                                                                                          : "lost";
+        result.status = RunStatus(result);
       } else if (std::filesystem::exists(run.run_folder / "failure.json")) {
         result.error = ReadJsonFile(run.run_folder / "failure.json").value("error", "unknown failure");
       } else {

@@ -17,7 +17,7 @@ struct RunResult {
   std::string sequence;
   std::string label;                // sweep point, "" without sweeps
   std::vector<std::string> point;   // "path=value" per swept option
-  std::string status = "failed";    // "ok", "lost" (tracking lost before the end), "not_initialised" or "failed"
+  std::string status = "failed";    // "ok", "lost", "not_initialised" (RunStatus) or "failed"
   std::string error;                // why it failed
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
@@ -81,6 +81,10 @@ struct RmseChangeCounts {
   double SignedRankP() const;
 };
 
+// A finished run's status from its figures: "not_initialised", "lost" (it ends without tracking,
+// or left frames after its initialisation untracked) or "ok". Image dropouts skipped with the
+// map kept do not make it "lost": they are the images', which every run of the sequence meets.
+std::string RunStatus(const RunResult& figures);
 // Where and why a run that ends without tracking stopped: "lost from frame 12: only 7 points
 // left after outlier rejection" or "never initialised: …"; "" when it ends tracking or failed.
 std::string StopText(const RunResult& result);
