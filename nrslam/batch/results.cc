@@ -386,7 +386,8 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     if (!StopText(r).empty()) out << RunKey(r) << ": " << StopText(r) << '\n';
     const std::string unreadable = UnreadableInputText(r.frames_unreadable, r.frames_groundtruth_unreadable);
     if (!unreadable.empty()) out << RunKey(r) << ": " << unreadable << '\n';
-    if (r.frames_dropout > 0) out << RunKey(r) << ": " << DropoutText(r.frames_dropout) << '\n';
+    const std::string dropouts = DropoutText(r.frames_dropout);
+    if (!dropouts.empty()) out << RunKey(r) << ": " << dropouts << '\n';
   }
   if (!swept) return;
   const std::vector<SweepValueSummary> values = SummariseSweep(results);

@@ -80,7 +80,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (!stop.empty()) text << '\n' << stop;
   const std::string unreadable = UnreadableInputText(summary.frames_unreadable, summary.frames_groundtruth_unreadable);
   if (!unreadable.empty()) text << '\n' << unreadable;
-  if (summary.frames_dropout > 0) text << '\n' << DropoutText(summary.frames_dropout);
+  const std::string dropouts = DropoutText(summary.frames_dropout);
+  if (!dropouts.empty()) text << '\n' << dropouts;
   return text.str();
 }
 
