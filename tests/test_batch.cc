@@ -568,6 +568,7 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   RunResult damaged = Result("sim-2", 0.5, 60);
   damaged.frames_evaluated = 58;
   damaged.frames_unreadable = 1;
+  damaged.frames_unreadable_after_init = 1;
   damaged.frames_groundtruth_unreadable = 2;
   damaged.frames_dropout = 3;
   const RunResult fine = Result("sim-0", 0.1, 60);
@@ -582,6 +583,8 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
   const std::vector<RunResult> read = ResultsFromJson(ToJson({damaged, fine}));
   EXPECT_EQ(read[0].frames_unreadable, 1);
+  EXPECT_EQ(read[0].frames_unreadable_after_init, 1);
+  EXPECT_EQ(read[1].frames_unreadable_after_init, 0);
   EXPECT_EQ(read[0].frames_groundtruth_unreadable, 2);
   EXPECT_EQ(read[1].frames_groundtruth_unreadable, 0);
   EXPECT_EQ(read[0].frames_dropout, 3);
@@ -589,7 +592,8 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
 }
 
 // A run is "lost" when it leaves frames after its initialisation untracked, or ends without
-// tracking; frames skipped as image dropouts with the map kept are the images' and do not count.
+// tracking; frames skipped as image dropouts with the map kept, and unreadable frames, are the
+// input's and do not count.
 TEST(Results, StatusFromTheFigures) {
   RunResult r;
   r.frames_total = 120;
@@ -601,6 +605,13 @@ TEST(Results, StatusFromTheFigures) {
   EXPECT_EQ(RunStatus(r), "lost");  // one frame lost on the way (e.g. a new map started after it)
   r.frames_dropout = 1;
   EXPECT_EQ(RunStatus(r), "ok");    // that frame was skipped as an image dropout
+  r.frames_dropout = 0;
+  r.frames_unreadable = 2;
+  EXPECT_EQ(RunStatus(r), "lost");  // unreadable, but the figures do not say the frame came after the start
+  r.frames_unreadable_after_init = 1;
+  EXPECT_EQ(RunStatus(r), "ok");    // it did: the input's, not the tracker's
+  r.frames_unreadable_after_init = 0;
+  r.frames_dropout = 1;
   r.stop_frame = 119;
   r.stop_reason = "only 0 of 180 points tracked: skipped as an image dropout, the map kept (1 of at most 5 in a row)";
   EXPECT_EQ(RunStatus(r), "lost");  // skipped at the end: the run ends without tracking

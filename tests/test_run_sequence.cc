@@ -1034,6 +1034,7 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   EXPECT_EQ(summary.frames_tracked, 9);
   EXPECT_EQ(summary.frames_lost, 1);
   EXPECT_EQ(summary.frames_unreadable, 1);
+  EXPECT_EQ(summary.frames_unreadable_after_init, 1);  // the map started on frame 0
   EXPECT_NE(DescribeSummary(summary).find("1 frame unreadable (lost); metrics.csv names the files"), std::string::npos)
       << DescribeSummary(summary);
   const std::vector<std::string> rows = FileLines(folder / "run" / "metrics.csv");
@@ -1097,6 +1098,7 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   EXPECT_EQ(late.init_frame, 1);
   EXPECT_EQ(late.frames_tracked, 9);
   EXPECT_EQ(late.frames_unreadable, 1);  // where the map starts, depth is input
+  EXPECT_EQ(late.frames_unreadable_after_init, 0);  // before the map: counted in init_frame
   const std::vector<std::string> late_metrics = FileLines(folder / "late_run" / "metrics.csv");
   ASSERT_EQ(late_metrics.size(), 11u);
   EXPECT_NE(late_metrics[1].find("000000.png"), std::string::npos) << late_metrics[1];

@@ -38,6 +38,8 @@ void ReadFigures(const Json& json, RunResult* result) {
   // Results written before the field existed always had ground truth for every tracked frame.
   result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
   result->frames_unreadable = json.value("frames_unreadable", 0);
+  // Results written before the field existed cannot tell: their unreadable frames count as lost.
+  result->frames_unreadable_after_init = json.value("frames_unreadable_after_init", 0);
   result->frames_groundtruth_unreadable = json.value("frames_groundtruth_unreadable", 0);
   result->frames_dropout = json.value("frames_dropout", 0);
   result->rmse_mm = json.value("rmse_mm", 0.0);
@@ -192,7 +194,8 @@ std::string RmseChangeCounts::ToString() const {
 
 std::string RunStatus(const RunResult& figures) {
   if (figures.init_frame < 0) return "not_initialised";
-  const bool every_frame = figures.init_frame + figures.frames_tracked + figures.frames_dropout >= figures.frames_total;
+  const int input_not_tracked = figures.frames_dropout + figures.frames_unreadable_after_init;
+  const bool every_frame = figures.init_frame + figures.frames_tracked + input_not_tracked >= figures.frames_total;
   return every_frame && figures.stop_reason.empty() ? "ok" : "lost";
 }
 
@@ -287,6 +290,7 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
                     {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated},
                     {"frames_unreadable", r.frames_unreadable},
+                    {"frames_unreadable_after_init", r.frames_unreadable_after_init},
                     {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable},
                     {"frames_dropout", r.frames_dropout}, {"rmse_mm", r.rmse_mm},
                     {"rmse_median_mm", r.rmse_median_mm},
@@ -335,14 +339,15 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
-         "frames_unreadable,frames_groundtruth_unreadable,frames_dropout,rmse_mm,rmse_median_mm,rmse_flat_mm,"
+         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_dropout,rmse_mm,rmse_median_mm,rmse_flat_mm,"
          "rmse_map_scale_mm,rmse_median_scale_mm,"
          "ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,"
          "error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
-        << r.frames_unreadable << ',' << r.frames_groundtruth_unreadable << ',' << r.frames_dropout << ',' << r.rmse_mm
+        << r.frames_unreadable << ',' << r.frames_unreadable_after_init << ',' << r.frames_groundtruth_unreadable << ','
+        << r.frames_dropout << ',' << r.rmse_mm
         << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','

@@ -22,6 +22,7 @@ struct RunResult {
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
   int frames_unreadable = 0;              // frames lost because their image could not be read
+  int frames_unreadable_after_init = 0;   // of them, those after the first map started
   int frames_groundtruth_unreadable = 0;  // tracked frames not scored: their ground-truth file was unreadable
   int frames_dropout = 0;                 // frames lost as image dropouts, the map kept
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
@@ -83,7 +84,8 @@ struct RmseChangeCounts {
 
 // A finished run's status from its figures: "not_initialised", "lost" (it ends without tracking,
 // or left frames after its initialisation untracked) or "ok". Image dropouts skipped with the
-// map kept do not make it "lost": they are the images', which every run of the sequence meets.
+// map kept and unreadable frames do not make it "lost": they are the input's, which every run
+// of the sequence meets.
 std::string RunStatus(const RunResult& figures);
 // Where and why a run that ends without tracking stopped: "lost from frame 12: only 7 points
 // left after outlier rejection" or "never initialised: …"; "" when it ends tracking or failed.

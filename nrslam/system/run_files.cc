@@ -160,6 +160,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_lost", summary.frames_lost},
                       {"frames_evaluated", summary.frames_evaluated},
                       {"frames_unreadable", summary.frames_unreadable},
+                      {"frames_unreadable_after_init", summary.frames_unreadable_after_init},
                       {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
                       {"frames_dropout", summary.frames_dropout},
                       {"init_frame", summary.init_frame},

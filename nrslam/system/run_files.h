@@ -37,6 +37,9 @@ struct RunSummary {
   // Frames lost because their colour image or mask could not be read (the run goes on), and
   // tracked frames left unscored because their ground-truth depth file could not be read.
   int frames_unreadable = 0, frames_groundtruth_unreadable = 0;
+  // Of frames_unreadable, those after the first map started: the batch's status tells them
+  // apart from frames the system failed to track (batch/results.h, RunStatus).
+  int frames_unreadable_after_init = 0;
   // Frames lost as image dropouts: skipped with the map kept (TrackingOptions::max_dropout_frames).
   int frames_dropout = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)

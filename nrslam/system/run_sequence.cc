@@ -236,6 +236,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       result.state = TrackingState::kLost;  // an unreadable frame: recorded, and the run goes on
       result.note = e.what();
       ++summary.frames_unreadable;
+      if (summary.init_frame >= 0) ++summary.frames_unreadable_after_init;
       log << "frame " << frame << ": " << e.what() << '\n';
     }
 
