@@ -121,6 +121,13 @@ TEST(JsonOptions, DisplacementPriorIsOffByDefaultAndNeverNegative) {
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"displacement_prior_sigma=-0.2"}), Error);
 }
 
+TEST(JsonOptions, DropoutShareIsAFraction) {
+  const TrackingOptions off = WithAssignments(TrackingOptions{}, {"min_tracked_fraction=0"});
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").min_tracked_fraction, 0.0);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"min_tracked_fraction=1.5"}), Error);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"min_tracked_fraction=-0.1"}), Error);
+}
+
 TEST(JsonOptions, DbaModelSelectionThresholdsAreValidatedAndRoundTrip) {
   const MappingOptions options = WithAssignments(
       MappingOptions{}, {"dba_model_selection=false", "rigid_dba_min_inliers=0.99", "rigid_dba_min_baseline=0.5"});

@@ -1237,6 +1237,35 @@ TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
   EXPECT_EQ(stopped.frames_dropout, 0);
 }
 
+// A frame of noise (garbled data) is a dropout too, by the share of the map's tracks the KLT
+// finds on it: a dozen lock onto chance patterns, enough to pass min_points, and no pose fits
+// them. Without the share rule the tracking experiment ends there.
+TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
+  const fs::path folder = *base_ / "noise";
+  fs::create_directories(folder);
+  fs::copy(*base_ / "sequence", folder / "sequence", fs::copy_options::recursive);
+  cv::Mat noise(240, 320, CV_8UC3);
+  cv::RNG(7).fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(15)).string(), noise);
+
+  const RunSummary skipped = RunSequence(folder / "sequence", TrackingExperiment(), folder / "skipped");
+  EXPECT_EQ(skipped.Status(), "ok");
+  EXPECT_EQ(skipped.frames_tracked, 39);
+  EXPECT_EQ(skipped.frames_dropout, 1);
+  const auto metrics = ReadCsv(folder / "skipped" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 40u);
+  EXPECT_GE(std::stoi(metrics[15].at("klt_tracked")), TrackingOptions{}.min_points);  // the count alone would pass it
+  EXPECT_NE(metrics[15].at("note").find("skipped as an image dropout"), std::string::npos) << metrics[15].at("note");
+  EXPECT_LT(skipped.rmse_mm, 1.25 * summary_->rmse_mm) << "without the noise: " << summary_->rmse_mm << " mm";
+
+  SystemOptions count_only = TrackingExperiment();
+  count_only.tracking.min_tracked_fraction = 0;
+  const RunSummary stopped = RunSequence(folder / "sequence", count_only, folder / "stopped");
+  EXPECT_EQ(stopped.Status(), "lost");
+  EXPECT_EQ(stopped.stop_frame, 15);
+  EXPECT_EQ(stopped.frames_dropout, 0);
+}
+
 // The same in the full monocular system: the mapper goes on with the map it had, where the
 // reference starts a new one.
 TEST(MonocularRun, AShortImageDropoutKeepsTheMap) {

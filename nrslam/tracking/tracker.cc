@@ -578,7 +578,9 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     ++map_tracks;
     map_tracks_found += matches[i].status == KltStatus::kTracked;
   }
-  if (map_tracks_found < options_.min_points && dropouts_in_a_row_ < options_.max_dropout_frames) {
+  const bool too_few = map_tracks_found < options_.min_points ||
+                       map_tracks_found < options_.min_tracked_fraction * map_tracks;
+  if (too_few && dropouts_in_a_row_ < options_.max_dropout_frames) {
     ++dropouts_in_a_row_;
     result.state = TrackingState::kLost;
     result.dropout = true;
