@@ -581,6 +581,15 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_NE(table.str().find("sim-2: 3 frames skipped as image dropouts (lost; the map kept)"), std::string::npos)
       << table.str();
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
+  EXPECT_EQ(RunNotes(damaged).size(), 2u);
+  EXPECT_TRUE(RunNotes(fine).empty());
+  // The report's section of the run says the same.
+  const auto folder = UniqueTempFolder("results_notes_report");
+  WriteReport({damaged, fine}, {}, {}, folder / "report");
+  std::ifstream report(folder / "report" / "index.html");
+  const std::string html((std::istreambuf_iterator<char>(report)), {});
+  EXPECT_NE(html.find("<p>3 frames skipped as image dropouts (lost; the map kept)</p>"), std::string::npos) << html;
+  std::filesystem::remove_all(folder);
   const std::vector<RunResult> read = ResultsFromJson(ToJson({damaged, fine}));
   EXPECT_EQ(read[0].frames_unreadable, 1);
   EXPECT_EQ(read[0].frames_unreadable_after_init, 1);

@@ -87,7 +87,7 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
        << RmseCell(result, result.rmse_mm) << " mm (median " << RmseCell(result, result.rmse_median_mm)
        << "; one scale per map: " << RecordedRmseCell(result, result.rmse_map_scale_mm) << "; a map at one depth: "
        << RecordedRmseCell(result, result.rmse_flat_mm) << "), trajectory error " << MillimetresCell(result.ate_mm) << " mm, run folder <code>" << EscapeXml(result.run_folder) << "</code></p>\n";
-  if (!StopText(result).empty()) html << "<p>Ended without tracking: " << EscapeXml(StopText(result)) << "</p>\n";
+  for (const std::string& note : RunNotes(result)) html << "<p>" << EscapeXml(note) << "</p>\n";
   try {
     const std::filesystem::path run = result.run_folder;
     const Json config = ReadJsonFile(run / "config.json");

@@ -203,6 +203,16 @@ std::string StopText(const RunResult& result) {
   return result.status == "failed" ? "" : DescribeStop(result.init_frame, result.stop_frame, result.stop_reason);
 }
 
+std::vector<std::string> RunNotes(const RunResult& result) {
+  std::vector<std::string> notes;
+  for (std::string note : {StopText(result), UnreadableInputText(result.frames_unreadable,
+                                                                 result.frames_groundtruth_unreadable),
+                           DropoutText(result.frames_dropout)}) {
+    if (!note.empty()) notes.push_back(std::move(note));
+  }
+  return notes;
+}
+
 std::string RmseCell(const RunResult& result, double rmse_mm) {
   if (result.evaluated()) return FormatFixed(rmse_mm, 3);
   return result.frames_tracked > 0 ? "no GT" : "-";  // with no frame tracked there was nothing to score
@@ -388,11 +398,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
   table.Print(out);
   for (const RunResult& r : results) {
     if (r.status == "failed") out << "FAILED " << RunKey(r) << ": " << r.error << '\n';
-    if (!StopText(r).empty()) out << RunKey(r) << ": " << StopText(r) << '\n';
-    const std::string unreadable = UnreadableInputText(r.frames_unreadable, r.frames_groundtruth_unreadable);
-    if (!unreadable.empty()) out << RunKey(r) << ": " << unreadable << '\n';
-    const std::string dropouts = DropoutText(r.frames_dropout);
-    if (!dropouts.empty()) out << RunKey(r) << ": " << dropouts << '\n';
+    for (const std::string& note : RunNotes(r)) out << RunKey(r) << ": " << note << '\n';
   }
   if (!swept) return;
   const std::vector<SweepValueSummary> values = SummariseSweep(results);

@@ -90,6 +90,9 @@ std::string RunStatus(const RunResult& figures);
 // Where and why a run that ends without tracking stopped: "lost from frame 12: only 7 points
 // left after outlier rejection" or "never initialised: …"; "" when it ends tracking or failed.
 std::string StopText(const RunResult& result);
+// What the table prints under a run that did not fail, one line each: its StopText and what
+// unreadable input and image dropouts cost it. Empty for a run that lost nothing.
+std::vector<std::string> RunNotes(const RunResult& result);
 // An RMSE figure of `result` as a table shows it: "no GT" when frames were tracked but none had
 // ground truth, "-" when no frame was tracked.
 std::string RmseCell(const RunResult& result, double rmse_mm);
