@@ -349,8 +349,8 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
-         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_dropout,rmse_mm,rmse_median_mm,rmse_flat_mm,"
-         "rmse_map_scale_mm,rmse_median_scale_mm,"
+         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_dropout,"
+         "rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,"
          "ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,"
          "error\n";
   for (const RunResult& r : results) {
