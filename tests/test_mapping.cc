@@ -222,7 +222,7 @@ class MonocularInitialiserTest : public ::testing::Test {
     options.min_points = 50;
     options.point_min_parallax_snr = point_min_parallax_snr;
     options.shading_weight = shading_weight;
-    MonocularInitialiser initialiser(reader.info().camera, FrontendOptions{}, 600, options);
+    MonocularInitialiser initialiser(reader.info().camera, FrontendOptions{}, TrackingOptions{}, options);
     for (*frame = 0; *frame < reader.frame_count(); ++*frame) {
       const cv::Mat bgr = reader.ReadRgb(*frame);
       cv::Mat mask = reader.ReadMask(*frame);

@@ -1291,5 +1291,36 @@ TEST(MonocularRun, AShortImageDropoutKeepsTheMap) {
   fs::remove_all(folder);
 }
 
+// While the map is being made from two views, a frame of noise is skipped the same way: the
+// initialiser keeps its reference and tracks. Without the rule the noise cuts most tracks, the
+// reference restarts on the noise frame itself, and the map comes later from a later reference.
+TEST(MonocularRun, ANoiseFrameWhileInitialisingKeepsTheReference) {
+  const fs::path folder = UniqueTempFolder("nrslam_monocular_init_noise");
+  fs::remove_all(folder);
+  SimulateSmall("sim-1", 40, 320, 240, folder / "sequence");
+  cv::Mat noise(240, 320, CV_8UC3);
+  cv::RNG(9).fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(2)).string(), noise);
+  const RunSummary skipped = RunSequence(folder / "sequence", SystemOptions{}, folder / "skipped");
+  const auto metrics = ReadCsv(folder / "skipped" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 40u);
+  EXPECT_NE(metrics[2].at("note").find("tracks found: skipped as an image dropout"), std::string::npos)
+      << metrics[2].at("note");
+  const auto log = FileLines(folder / "skipped" / "run.log");
+  EXPECT_TRUE(std::any_of(log.begin(), log.end(), [](const std::string& line) {
+    return line.find("initialised from frames 0 and") != std::string::npos;
+  }));
+  SystemOptions count_only;
+  count_only.tracking.min_tracked_fraction = 0;
+  const RunSummary restarted = RunSequence(folder / "sequence", count_only, folder / "restarted");
+  const auto restarted_metrics = ReadCsv(folder / "restarted" / "metrics.csv");
+  ASSERT_EQ(restarted_metrics.size(), 40u);
+  EXPECT_NE(restarted_metrics[2].at("note").find("new reference"), std::string::npos) << restarted_metrics[2].at("note");
+  ASSERT_GE(skipped.init_frame, 0);
+  EXPECT_LT(skipped.init_frame, restarted.init_frame);
+  EXPECT_GT(skipped.frames_tracked, restarted.frames_tracked);
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace nrslam

@@ -57,9 +57,10 @@ Keyframe ReferenceKeyframe(const InitialMap& map) {
   return keyframe;
 }
 
-MonocularInitialiser::MonocularInitialiser(const Camera& camera, const FrontendOptions& frontend, int max_points,
-                                           const InitialisationOptions& options)
-    : camera_(camera), frontend_(frontend), max_points_(max_points), options_(options), klt_(frontend.klt) {
+MonocularInitialiser::MonocularInitialiser(const Camera& camera, const FrontendOptions& frontend,
+                                           const TrackingOptions& tracking, const InitialisationOptions& options)
+    : camera_(camera), frontend_(frontend), tracking_(tracking), options_(options), klt_(frontend.klt) {
+  tracking_.Check();
   options_.Check();
 }
 
@@ -67,7 +68,7 @@ InitialisationAttempt MonocularInitialiser::StartReference(int frame, const cv::
                                                            const std::string& why) {
   const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
   FeatureOptions features = frontend_.features;
-  features.max_features = max_points_;
+  features.max_features = tracking_.max_points;
   reference_pixels_ = DetectCorners(grey, valid, {}, features);
   klt_.SetReference(ImagePyramid(grey, frontend_.klt.levels), reference_pixels_, valid);
   reference_brightness_.clear();
@@ -75,6 +76,7 @@ InitialisationAttempt MonocularInitialiser::StartReference(int frame, const cv::
     reference_brightness_ = LinearBrightness(grey, valid, reference_pixels_, frontend_.shading);
   }
   reference_frame_ = frame;
+  dropouts_in_a_row_ = 0;
   history_.assign(reference_pixels_.size(), {});
   alive_.assign(reference_pixels_.size(), false);
   for (size_t i = 0; i < reference_pixels_.size(); ++i) {
@@ -101,9 +103,26 @@ InitialisationAttempt MonocularInitialiser::Add(int frame, const cv::Mat& bgr, c
     const int x = cvRound(p.x), y = cvRound(p.y);
     return x >= 0 && y >= 0 && x < valid.cols && y < valid.rows && valid.at<uint8_t>(y, x) != 0;
   };
+  std::vector<bool> found(history_.size());
+  int live = 0, live_found = 0;
+  for (size_t i = 0; i < history_.size(); ++i) {
+    found[i] = alive_[i] && matches[i].status == KltStatus::kTracked && on_valid(matches[i].position);
+    live += alive_[i];
+    live_found += found[i];
+  }
+  // Counted before any track is cut, so that a skipped frame leaves the tracks as they were.
+  if (live_found < tracking_.min_tracked_fraction * live && dropouts_in_a_row_ < tracking_.max_dropout_frames) {
+    ++dropouts_in_a_row_;
+    InitialisationAttempt attempt;
+    attempt.note = "only " + std::to_string(live_found) + " of " + std::to_string(live) +
+                   " tracks found: skipped as an image dropout (" + std::to_string(dropouts_in_a_row_) +
+                   " of at most " + std::to_string(tracking_.max_dropout_frames) + " in a row)";
+    return attempt;
+  }
+  dropouts_in_a_row_ = 0;
   std::vector<int> tracks;
   for (size_t i = 0; i < history_.size(); ++i) {
-    alive_[i] = alive_[i] && matches[i].status == KltStatus::kTracked && on_valid(matches[i].position);
+    alive_[i] = found[i];
     if (!alive_[i]) continue;
     history_[i].push_back(matches[i].position);
     tracks.push_back(static_cast<int>(i));

@@ -8,6 +8,9 @@
 // inverse-depth weighted mid-point; the map is accepted once enough points pass the
 // parallax, depth and reprojection gates and few inliers still lack parallax. The map is then
 // scaled to the target median depth. The reference restarts when its tracks run out or it ages.
+// An image dropout (a frame on which the KLT finds under tracking.min_tracked_fraction of the
+// live tracks: blank, noise) is skipped as tracking skips one, up to max_dropout_frames in a row,
+// rather than cutting the tracks or becoming the reference.
 // With initialisation.shading_weight > 0 the points' distances are blended with what the
 // reference image's brightness says (frontend/shading.h) before the map is scaled.
 #pragma once
@@ -50,16 +53,20 @@ struct InitialisationAttempt {
 
 class MonocularInitialiser {
  public:
-  MonocularInitialiser(const Camera& camera, const FrontendOptions& frontend, int max_points,
+  // Of `tracking`, the corner budget (max_points) and the image-dropout rule.
+  MonocularInitialiser(const Camera& camera, const FrontendOptions& frontend, const TrackingOptions& tracking,
                        const InitialisationOptions& options);
 
   InitialisationAttempt Add(int frame, const cv::Mat& bgr, const cv::Mat& mask);
-  void Reset() { reference_frame_ = -1; }
+  void Reset() {
+    reference_frame_ = -1;
+    dropouts_in_a_row_ = 0;
+  }
 
  private:
   Camera camera_;
   FrontendOptions frontend_;
-  int max_points_;
+  TrackingOptions tracking_;
   InitialisationOptions options_;
   KltTracker klt_;
   int reference_frame_ = -1;
@@ -67,6 +74,7 @@ class MonocularInitialiser {
   std::vector<double> reference_brightness_;  // per reference corner; read only for the shading prior
   std::vector<std::vector<cv::Point2f>> history_;  // per reference corner, its pixel in every frame since
   std::vector<bool> alive_;
+  int dropouts_in_a_row_ = 0;
 
   InitialisationAttempt StartReference(int frame, const cv::Mat& grey, const cv::Mat& mask, const std::string& why);
   InitialisationAttempt Reconstruct(const std::vector<int>& tracks) const;

@@ -144,7 +144,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   Tracker tracker(camera, options.frontend, options.deformation, options.tracking);
   tracker.EnableCandidates(options.run.mapping);
   Mapper mapper(camera, options.frontend, options.deformation, options.mapping, options.tracking.rigid);
-  MonocularInitialiser initialiser(camera, options.frontend, options.tracking.max_points, options.initialisation);
+  MonocularInitialiser initialiser(camera, options.frontend, options.tracking, options.initialisation);
   const bool monocular = options.run.init == "monocular";
   int maps = 0;  // maps started so far: a monocular run starts a new one after each loss
   // Each map numbers its points from 0; points.csv offsets them by the points of the run's
