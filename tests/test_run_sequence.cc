@@ -1190,6 +1190,16 @@ TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {
   fs::remove_all(folder);
 }
 
+// The tracking experiment on `folder`/sequence with `options` (a dropout rule turned off) ends at
+// `frame`, the first spoiled one, having tracked every frame before it.
+void ExpectLostFromFrame(const fs::path& folder, const SystemOptions& options, int frame) {
+  const RunSummary stopped = RunSequence(folder / "sequence", options, folder / "stopped");
+  EXPECT_EQ(stopped.Status(), "lost");
+  EXPECT_EQ(stopped.stop_frame, frame);
+  EXPECT_EQ(stopped.frames_tracked, frame);
+  EXPECT_EQ(stopped.frames_dropout, 0);
+}
+
 // A few blank frames in the middle of a run (a flush, the lens against the tissue) are skipped
 // with the map kept: tracking picks up where it left off, on the same points, about as accurate
 // as without the gap. Without the skip (the reference), the tracking experiment ends there.
@@ -1230,11 +1240,7 @@ TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
 
   SystemOptions reference = TrackingExperiment();
   reference.tracking.max_dropout_frames = 0;
-  const RunSummary stopped = RunSequence(folder / "sequence", reference, folder / "stopped");
-  EXPECT_EQ(stopped.Status(), "lost");
-  EXPECT_EQ(stopped.stop_frame, 15);
-  EXPECT_EQ(stopped.frames_tracked, 15);
-  EXPECT_EQ(stopped.frames_dropout, 0);
+  ExpectLostFromFrame(folder, reference, 15);
 }
 
 // A frame of noise (garbled data) is a dropout too, by the share of the map's tracks the KLT
@@ -1260,10 +1266,7 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
 
   SystemOptions count_only = TrackingExperiment();
   count_only.tracking.min_tracked_fraction = 0;
-  const RunSummary stopped = RunSequence(folder / "sequence", count_only, folder / "stopped");
-  EXPECT_EQ(stopped.Status(), "lost");
-  EXPECT_EQ(stopped.stop_frame, 15);
-  EXPECT_EQ(stopped.frames_dropout, 0);
+  ExpectLostFromFrame(folder, count_only, 15);
 }
 
 // The same in the full monocular system: the mapper goes on with the map it had, where the
