@@ -59,8 +59,9 @@ Keyframe ReferenceKeyframe(const InitialMap& map) {
 
 MonocularInitialiser::MonocularInitialiser(const Camera& camera, const FrontendOptions& frontend,
                                            const TrackingOptions& tracking, const InitialisationOptions& options)
-    : camera_(camera), frontend_(frontend), tracking_(tracking), options_(options), klt_(frontend.klt) {
-  tracking_.Check();
+    : camera_(camera), frontend_(frontend), max_points_(tracking.max_points), options_(options),
+      klt_(frontend.klt), dropouts_(tracking) {
+  tracking.Check();
   options_.Check();
 }
 
@@ -68,7 +69,7 @@ InitialisationAttempt MonocularInitialiser::StartReference(int frame, const cv::
                                                            const std::string& why) {
   const cv::Mat valid = BuildValidityMask(grey, mask, frontend_.masks);
   FeatureOptions features = frontend_.features;
-  features.max_features = tracking_.max_points;
+  features.max_features = max_points_;
   reference_pixels_ = DetectCorners(grey, valid, {}, features);
   klt_.SetReference(ImagePyramid(grey, frontend_.klt.levels), reference_pixels_, valid);
   reference_brightness_.clear();
@@ -76,7 +77,7 @@ InitialisationAttempt MonocularInitialiser::StartReference(int frame, const cv::
     reference_brightness_ = LinearBrightness(grey, valid, reference_pixels_, frontend_.shading);
   }
   reference_frame_ = frame;
-  dropouts_in_a_row_ = 0;
+  dropouts_.Reset();
   history_.assign(reference_pixels_.size(), {});
   alive_.assign(reference_pixels_.size(), false);
   for (size_t i = 0; i < reference_pixels_.size(); ++i) {
@@ -111,15 +112,12 @@ InitialisationAttempt MonocularInitialiser::Add(int frame, const cv::Mat& bgr, c
     live_found += found[i];
   }
   // Counted before any track is cut, so that a skipped frame leaves the tracks as they were.
-  if (live_found < tracking_.min_tracked_fraction * live && dropouts_in_a_row_ < tracking_.max_dropout_frames) {
-    ++dropouts_in_a_row_;
+  // By the share alone: tracks that run out gradually restart the reference below, as before.
+  if (dropouts_.Skip(live_found, live, 0)) {
     InitialisationAttempt attempt;
-    attempt.note = "only " + std::to_string(live_found) + " of " + std::to_string(live) +
-                   " tracks found: skipped as an image dropout (" + std::to_string(dropouts_in_a_row_) +
-                   " of at most " + std::to_string(tracking_.max_dropout_frames) + " in a row)";
+    attempt.note = dropouts_.Note(live_found, live, "tracks found", "");
     return attempt;
   }
-  dropouts_in_a_row_ = 0;
   std::vector<int> tracks;
   for (size_t i = 0; i < history_.size(); ++i) {
     alive_[i] = found[i];

@@ -60,13 +60,13 @@ class MonocularInitialiser {
   InitialisationAttempt Add(int frame, const cv::Mat& bgr, const cv::Mat& mask);
   void Reset() {
     reference_frame_ = -1;
-    dropouts_in_a_row_ = 0;
+    dropouts_.Reset();
   }
 
  private:
   Camera camera_;
   FrontendOptions frontend_;
-  TrackingOptions tracking_;
+  int max_points_;
   InitialisationOptions options_;
   KltTracker klt_;
   int reference_frame_ = -1;
@@ -74,7 +74,7 @@ class MonocularInitialiser {
   std::vector<double> reference_brightness_;  // per reference corner; read only for the shading prior
   std::vector<std::vector<cv::Point2f>> history_;  // per reference corner, its pixel in every frame since
   std::vector<bool> alive_;
-  int dropouts_in_a_row_ = 0;
+  ImageDropouts dropouts_;
 
   InitialisationAttempt StartReference(int frame, const cv::Mat& grey, const cv::Mat& mask, const std::string& why);
   InitialisationAttempt Reconstruct(const std::vector<int>& tracks) const;

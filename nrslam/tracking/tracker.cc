@@ -147,7 +147,7 @@ FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv:
 
   cam_from_world_ = seed.cam_from_world;
   motion_ = Rigid3();
-  dropouts_in_a_row_ = 0;
+  dropouts_.Reset();
   RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels),
                    BuildValidityMask(grey, mask, frontend_.masks));
   state_ = TrackingState::kTracking;
@@ -578,21 +578,15 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     ++map_tracks;
     map_tracks_found += matches[i].status == KltStatus::kTracked;
   }
-  const bool too_few = map_tracks_found < options_.min_points ||
-                       map_tracks_found < options_.min_tracked_fraction * map_tracks;
-  if (too_few && dropouts_in_a_row_ < options_.max_dropout_frames) {
-    ++dropouts_in_a_row_;
+  if (dropouts_.Skip(map_tracks_found, map_tracks, options_.min_points)) {
     result.state = TrackingState::kLost;
     result.dropout = true;
     result.klt_tracked = map_tracks_found;
-    result.note = "only " + std::to_string(map_tracks_found) + " of " + std::to_string(map_tracks) +
-                  " points tracked: skipped as an image dropout, the map kept (" + std::to_string(dropouts_in_a_row_) +
-                  " of at most " + std::to_string(options_.max_dropout_frames) + " in a row)";
+    result.note = dropouts_.Note(map_tracks_found, map_tracks, "points tracked", ", the map kept");
     result.ms_klt = MillisecondsSince(start);
     result.ms_total = result.ms_klt;
     return result;
   }
-  dropouts_in_a_row_ = 0;
   std::vector<Observation> observations;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;

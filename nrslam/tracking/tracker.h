@@ -24,6 +24,7 @@
 #include "nrslam/frontend/klt_tracker.h"
 #include "nrslam/geometry/rigid3.h"
 #include "nrslam/map/map.h"
+#include "nrslam/tracking/image_dropouts.h"
 #include "nrslam/tracking/tracking_options.h"
 
 namespace nrslam {
@@ -159,7 +160,7 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialised;
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
-  int dropouts_in_a_row_ = 0;  // image dropouts skipped since the last tracked frame
+  ImageDropouts dropouts_{options_};
   // By point id: how far the last frame's tracking moved it (with deformation_motion_seed;
   // during the deformation stage, where each point started).
   std::vector<Eigen::Vector3d> point_motion_;
