@@ -4,6 +4,7 @@
 
 #include <omp.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <unistd.h>
 
@@ -94,6 +95,13 @@ class RunSequenceTest : public ::testing::Test {
     fs::remove_all(*base_);
     delete base_;
     delete summary_;
+  }
+  // A copy of the sequence in a folder of its own (folder / "sequence"), to spoil frames of.
+  static fs::path CopyOfSequence(const std::string& name) {
+    const fs::path folder = *base_ / name;
+    fs::create_directories(folder);
+    fs::copy(*base_ / "sequence", folder / "sequence", fs::copy_options::recursive);
+    return folder;
   }
   static fs::path* base_;
   static RunSummary* summary_;
@@ -1204,9 +1212,7 @@ void ExpectLostFromFrame(const fs::path& folder, const SystemOptions& options, i
 // with the map kept: tracking picks up where it left off, on the same points, about as accurate
 // as without the gap. Without the skip (the reference), the tracking experiment ends there.
 TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
-  const fs::path folder = *base_ / "dropout";
-  fs::create_directories(folder);
-  fs::copy(*base_ / "sequence", folder / "sequence", fs::copy_options::recursive);
+  const fs::path folder = CopyOfSequence("dropout");
   const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
   for (int frame = 15; frame < 18; ++frame) {
     cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(frame)).string(), grey);
@@ -1247,9 +1253,7 @@ TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
 // finds on it: a dozen lock onto chance patterns, enough to pass min_points, and no pose fits
 // them. Without the share rule the tracking experiment ends there.
 TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
-  const fs::path folder = *base_ / "noise";
-  fs::create_directories(folder);
-  fs::copy(*base_ / "sequence", folder / "sequence", fs::copy_options::recursive);
+  const fs::path folder = CopyOfSequence("noise");
   cv::Mat noise(240, 320, CV_8UC3);
   cv::RNG(7).fill(noise, cv::RNG::UNIFORM, 0, 256);
   cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(15)).string(), noise);
@@ -1267,6 +1271,36 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
   SystemOptions count_only = TrackingExperiment();
   count_only.tracking.min_tracked_fraction = 0;
   ExpectLostFromFrame(folder, count_only, 15);
+}
+
+// An instrument over most of the view hides more than half of the map's tracks, but those it
+// leaves are right: the share is counted where any track was found, so the frames are tracked
+// on the visible part, not skipped. Counted over the whole image (dropout_tracks_per_cell 0),
+// they were skipped as dropouts.
+TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
+  const fs::path folder = CopyOfSequence("instrument");
+  for (int frame = 15; frame < 18; ++frame) {
+    const fs::path file = folder / "sequence" / "rgb" / FrameFileName(frame);
+    cv::Mat image = cv::imread(file.string());
+    const std::vector<cv::Point> shaft = {{80, 50}, {320, 0}, {320, 240}, {80, 190}};
+    cv::fillConvexPoly(image, shaft, cv::Scalar(120, 125, 130));
+    cv::imwrite(file.string(), image);
+  }
+
+  const RunSummary tracked = RunSequence(folder / "sequence", TrackingExperiment(), folder / "tracked");
+  EXPECT_EQ(tracked.Status(), "ok");
+  EXPECT_EQ(tracked.frames_dropout, 0);
+  EXPECT_EQ(tracked.frames_tracked, 40);
+  const auto metrics = ReadCsv(folder / "tracked" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 40u);
+  for (int frame = 15; frame < 18; ++frame) EXPECT_EQ(metrics[static_cast<size_t>(frame)].at("state"), "tracking");
+  // The instrument hid more than half of the tracks: the share over the whole image would skip it.
+  EXPECT_LT(2 * std::stoi(metrics[15].at("klt_tracked")), std::stoi(metrics[14].at("points")));
+
+  SystemOptions whole_image = TrackingExperiment();
+  whole_image.tracking.dropout_tracks_per_cell = 0;
+  const RunSummary skipped = RunSequence(folder / "sequence", whole_image, folder / "skipped");
+  EXPECT_EQ(skipped.frames_dropout, 3);
 }
 
 // The same in the full monocular system: the mapper goes on with the map it had, where the

@@ -105,17 +105,16 @@ InitialisationAttempt MonocularInitialiser::Add(int frame, const cv::Mat& bgr, c
     return x >= 0 && y >= 0 && x < valid.cols && y < valid.rows && valid.at<uint8_t>(y, x) != 0;
   };
   std::vector<bool> found(history_.size());
-  int live = 0, live_found = 0;
+  std::vector<ImageDropouts::LiveTrack> live;
   for (size_t i = 0; i < history_.size(); ++i) {
     found[i] = alive_[i] && matches[i].status == KltStatus::kTracked && on_valid(matches[i].position);
-    live += alive_[i];
-    live_found += found[i];
+    if (alive_[i]) live.push_back({history_[i].back(), found[i]});
   }
   // Counted before any track is cut, so that a skipped frame leaves the tracks as they were.
   // By the share alone: tracks that run out gradually restart the reference below, as before.
-  if (dropouts_.Skip(live_found, live, 0)) {
+  if (dropouts_.Skip(live, grey.size(), 0)) {
     InitialisationAttempt attempt;
-    attempt.note = dropouts_.Note(live_found, live, "tracks found", "");
+    attempt.note = dropouts_.Note("tracks found", "");
     return attempt;
   }
   std::vector<int> tracks;

@@ -6,7 +6,10 @@
 // used again whatever they hold.
 #pragma once
 
+#include <opencv2/core/types.hpp>
+
 #include <string>
+#include <vector>
 
 #include "nrslam/tracking/tracking_options.h"
 
@@ -14,31 +17,45 @@ namespace nrslam {
 
 class ImageDropouts {
  public:
-  explicit ImageDropouts(const TrackingOptions& options)
-      : max_in_a_row_(options.max_dropout_frames), min_fraction_(options.min_tracked_fraction) {}
+  // A track alive before this frame: where it was last, and whether the KLT found it now.
+  struct LiveTrack {
+    cv::Point2f last_pixel;
+    bool found;
+  };
 
-  // Whether to skip a frame on which `found` of `live` tracks were found: fewer than
-  // `min_found`, or than the options' min_tracked_fraction of them, while the allowance lasts.
-  // A skip is counted; a frame used ends the run of skips.
-  bool Skip(int found, int live, int min_found) {
-    const bool too_few = found < min_found || found < min_fraction_ * live;
-    in_a_row_ = too_few && in_a_row_ < max_in_a_row_ ? in_a_row_ + 1 : 0;
-    return in_a_row_ > 0;
-  }
+  explicit ImageDropouts(const TrackingOptions& options)
+      : max_in_a_row_(options.max_dropout_frames),
+        min_fraction_(options.min_tracked_fraction),
+        tracks_per_cell_(options.dropout_tracks_per_cell) {}
+
+  // Whether to skip a frame of `image_size` on which the KLT found fewer than `min_found` of
+  // the live tracks, or (with a min_tracked_fraction) none, or fewer than that fraction of those
+  // it counts, while the allowance lasts. It counts the live tracks in the cells of a grid over
+  // the image that hold a found one, the grid holding about dropout_tracks_per_cell live tracks
+  // a cell: noise lets a few chance tracks through all over the image and leaves nearly every
+  // track counted, whereas an instrument or a mask over part of the view takes the tracks it
+  // hides out of the count. A skip is counted; a frame used ends the run of skips.
+  bool Skip(const std::vector<LiveTrack>& tracks, cv::Size image_size, int min_found);
   void Reset() { in_a_row_ = 0; }
 
-  // The skipped frame's note: "only 11 of 119 points tracked: skipped as an image dropout, the
-  // map kept (1 of at most 5 in a row)" for counted = "points tracked", kept = ", the map kept".
-  std::string Note(int found, int live, const std::string& counted, const std::string& kept) const {
-    return "only " + std::to_string(found) + " of " + std::to_string(live) + " " + counted +
-           ": skipped as an image dropout" + kept + " (" + std::to_string(in_a_row_) + " of at most " +
-           std::to_string(max_in_a_row_) + " in a row)";
-  }
+  // The tracks found on the last frame given to Skip.
+  int found() const { return found_; }
+
+  // The last skipped frame's note: "only 11 of 119 points tracked: skipped as an image dropout,
+  // the map kept (1 of at most 5 in a row)" for counted = "points tracked", kept = ", the map
+  // kept"; when the share counted fewer tracks than all, "(11 of the 100 where any were found;
+  // 1 of at most 5 in a row)".
+  std::string Note(const std::string& counted, const std::string& kept) const;
 
  private:
+  // The live tracks in the cells that hold a found one.
+  int CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size) const;
+
   int max_in_a_row_;
   double min_fraction_;
+  int tracks_per_cell_;
   int in_a_row_ = 0;
+  int live_ = 0, found_ = 0, counted_ = 0;
 };
 
 }  // namespace nrslam

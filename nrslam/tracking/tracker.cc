@@ -572,17 +572,16 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   if (ahead) result.ms_klt_ahead = ahead->ms;
   // An image that matches too few of the map's tracks (blank, saturated, washed out) is skipped
   // before anything here changes: the next frame starts from where the last tracked one left them.
-  int map_tracks = 0, map_tracks_found = 0;
+  std::vector<ImageDropouts::LiveTrack> map_tracks;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active || tracks_[i].id == kNoPoint) continue;
-    ++map_tracks;
-    map_tracks_found += matches[i].status == KltStatus::kTracked;
+    map_tracks.push_back({tracks_[i].pixel, matches[i].status == KltStatus::kTracked});
   }
-  if (dropouts_.Skip(map_tracks_found, map_tracks, options_.min_points)) {
+  if (dropouts_.Skip(map_tracks, grey.size(), options_.min_points)) {
     result.state = TrackingState::kLost;
     result.dropout = true;
-    result.klt_tracked = map_tracks_found;
-    result.note = dropouts_.Note(map_tracks_found, map_tracks, "points tracked", ", the map kept");
+    result.klt_tracked = dropouts_.found();
+    result.note = dropouts_.Note("points tracked", ", the map kept");
     result.ms_klt = MillisecondsSince(start);
     result.ms_total = result.ms_klt;
     return result;

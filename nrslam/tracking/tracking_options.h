@@ -23,6 +23,11 @@ struct TrackingOptions {
   // no pose fits. A tracked frame of the simulated suites keeps ≥ 89 % of them. 0: only
   // min_points decides.
   double min_tracked_fraction = 0.5;
+  // ... counted only over the parts of the image where any track was found: the cells, holding
+  // about this many live tracks each, of a square grid that hold one. So an instrument or a
+  // mask that hides most of the tracks does not make a frame a dropout, while noise, whose few
+  // chance tracks are spread over the image, still does. 0: over the whole image.
+  int dropout_tracks_per_cell = 6;
   int pose_rounds = 3;                // rigid pose-only refinement: outlier rounds ...
   int pose_iterations = 10;           // ... of this many LM iterations each
   double pose_sigma_px = 1.0;         // σ of the rigid refinement's reprojection residuals
@@ -63,7 +68,7 @@ struct TrackingOptions {
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
-                                                max_dropout_frames, min_tracked_fraction,
+                                                max_dropout_frames, min_tracked_fraction, dropout_tracks_per_cell,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
                                                 deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
                                                 displacement_prior_sigma, deformation_motion_seed,
