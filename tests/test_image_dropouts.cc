@@ -70,6 +70,8 @@ TEST(ImageDropouts, NoTrackFoundIsADropoutUnlessTheShareRuleIsOff) {
   const auto none = Lattice([](float, float, int) { return false; });
   ImageDropouts dropouts(WithTracksPerCell(16));
   EXPECT_TRUE(dropouts.Skip(none, kImage, 0));
+  EXPECT_EQ(dropouts.Note("tracks found", ""),
+            "only 0 of 256 tracks found: skipped as an image dropout (1 of at most 5 in a row)");
   TrackingOptions off = WithTracksPerCell(16);
   off.min_tracked_fraction = 0;
   ImageDropouts count_only(off);

@@ -43,7 +43,7 @@ int ImageDropouts::CountedLive(const std::vector<LiveTrack>& tracks, cv::Size im
 
 std::string ImageDropouts::Note(const std::string& counted, const std::string& kept) const {
   std::string share;
-  if (counted_ < live_) {
+  if (counted_ > 0 && counted_ < live_) {  // none found: no part of the image to name
     share = std::to_string(found_) + " of the " + std::to_string(counted_) + " where any were found; ";
   }
   return "only " + std::to_string(found_) + " of " + std::to_string(live_) + " " + counted +

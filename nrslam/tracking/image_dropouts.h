@@ -43,7 +43,7 @@ class ImageDropouts {
 
   // The last skipped frame's note: "only 11 of 119 points tracked: skipped as an image dropout,
   // the map kept (1 of at most 5 in a row)" for counted = "points tracked", kept = ", the map
-  // kept"; when the share counted fewer tracks than all, "(11 of the 100 where any were found;
+  // kept"; when the share counted some but not all of them, "(11 of the 100 where any were found;
   // 1 of at most 5 in a row)".
   std::string Note(const std::string& counted, const std::string& kept) const;
 
