@@ -23,21 +23,21 @@ bool ImageDropouts::Skip(const std::vector<LiveTrack>& tracks, cv::Size image_si
   return in_a_row_ > 0;
 }
 
-int ImageDropouts::CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size) const {
+int ImageDropouts::CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size) {
   const int grid =
       tracks_per_cell_ > 0
           ? std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(tracks.size()) / tracks_per_cell_))))
           : 1;
-  std::vector<int> live_in_cell(grid * grid, 0);
-  std::vector<bool> found_in_cell(grid * grid, false);
+  live_in_cell_.assign(grid * grid, 0);  // every frame: the buffers keep their capacity
+  found_in_cell_.assign(grid * grid, false);
   for (const LiveTrack& track : tracks) {
     const int cell =
         Cell(track.last_pixel.y, image_size.height, grid) * grid + Cell(track.last_pixel.x, image_size.width, grid);
-    ++live_in_cell[cell];
-    if (track.found) found_in_cell[cell] = true;
+    ++live_in_cell_[cell];
+    if (track.found) found_in_cell_[cell] = true;
   }
   int counted = 0;
-  for (size_t cell = 0; cell < live_in_cell.size(); ++cell) counted += found_in_cell[cell] ? live_in_cell[cell] : 0;
+  for (size_t cell = 0; cell < live_in_cell_.size(); ++cell) counted += found_in_cell_[cell] ? live_in_cell_[cell] : 0;
   return counted;
 }
 

@@ -49,13 +49,15 @@ class ImageDropouts {
 
  private:
   // The live tracks in the cells that hold a found one.
-  int CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size) const;
+  int CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size);
 
   int max_in_a_row_;
   double min_fraction_;
   int tracks_per_cell_;
   int in_a_row_ = 0;
   int live_ = 0, found_ = 0, counted_ = 0;
+  std::vector<int> live_in_cell_;
+  std::vector<bool> found_in_cell_;
 };
 
 }  // namespace nrslam
