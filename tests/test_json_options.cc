@@ -126,8 +126,8 @@ TEST(JsonOptions, DropoutShareIsAFraction) {
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").min_tracked_fraction, 0.0);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"min_tracked_fraction=1.5"}), Error);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"min_tracked_fraction=-0.1"}), Error);
-  const TrackingOptions whole_image = WithAssignments(TrackingOptions{}, {"dropout_tracks_per_cell=0"});
-  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(whole_image), "test").dropout_tracks_per_cell, 0);
+  const TrackingOptions by_cells = WithAssignments(TrackingOptions{}, {"dropout_tracks_per_cell=6"});
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(by_cells), "test").dropout_tracks_per_cell, 6);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"dropout_tracks_per_cell=-1"}), Error);
 }
 

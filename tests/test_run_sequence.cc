@@ -1274,10 +1274,10 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
 }
 
 // An instrument over most of the view hides more than half of the map's tracks, but those it
-// leaves are right: the share is counted where any track was found, so the frames are tracked
-// on the visible part, not skipped. Counted over the whole image (dropout_tracks_per_cell 0),
-// they were skipped as dropouts.
-TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
+// leaves are right. With the share counted where any track was found (dropout_tracks_per_cell
+// 6), the frames are tracked on the visible part; counted over the whole image (the default),
+// they are skipped as dropouts.
+TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropoutByCells) {
   const fs::path folder = CopyOfSequence("instrument");
   for (int frame = 15; frame < 18; ++frame) {
     const fs::path file = folder / "sequence" / "rgb" / FrameFileName(frame);
@@ -1287,19 +1287,18 @@ TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
     cv::imwrite(file.string(), image);
   }
 
-  const RunSummary tracked = RunSequence(folder / "sequence", TrackingExperiment(), folder / "tracked");
+  SystemOptions by_cells = TrackingExperiment();
+  by_cells.tracking.dropout_tracks_per_cell = 6;
+  const RunSummary tracked = RunSequence(folder / "sequence", by_cells, folder / "tracked");
   EXPECT_EQ(tracked.Status(), "ok");
   EXPECT_EQ(tracked.frames_dropout, 0);
   EXPECT_EQ(tracked.frames_tracked, 40);
   const auto metrics = ReadCsv(folder / "tracked" / "metrics.csv");
   ASSERT_EQ(metrics.size(), 40u);
   for (int frame = 15; frame < 18; ++frame) EXPECT_EQ(metrics[static_cast<size_t>(frame)].at("state"), "tracking");
-  // The instrument hid more than half of the tracks: the share over the whole image would skip it.
+  // The instrument hid more than half of the tracks: the share over the whole image skips it.
   EXPECT_LT(2 * std::stoi(metrics[15].at("klt_tracked")), std::stoi(metrics[14].at("points")));
-
-  SystemOptions whole_image = TrackingExperiment();
-  whole_image.tracking.dropout_tracks_per_cell = 0;
-  const RunSummary skipped = RunSequence(folder / "sequence", whole_image, folder / "skipped");
+  const RunSummary skipped = RunSequence(folder / "sequence", TrackingExperiment(), folder / "skipped");
   EXPECT_EQ(skipped.frames_dropout, 3);
 }
 
