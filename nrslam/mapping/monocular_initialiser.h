@@ -58,10 +58,7 @@ class MonocularInitialiser {
                        const InitialisationOptions& options);
 
   InitialisationAttempt Add(int frame, const cv::Mat& bgr, const cv::Mat& mask);
-  void Reset() {
-    reference_frame_ = -1;
-    dropouts_.Reset();
-  }
+  void Reset() { reference_frame_ = -1; }  // the next Add starts a reference (and the dropout count)
 
  private:
   Camera camera_;

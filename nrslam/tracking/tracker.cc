@@ -572,12 +572,12 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   if (ahead) result.ms_klt_ahead = ahead->ms;
   // An image that matches too few of the map's tracks (blank, saturated, washed out) is skipped
   // before anything here changes: the next frame starts from where the last tracked one left them.
-  std::vector<ImageDropouts::LiveTrack> map_tracks;
+  map_tracks_.clear();
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active || tracks_[i].id == kNoPoint) continue;
-    map_tracks.push_back({tracks_[i].pixel, matches[i].status == KltStatus::kTracked});
+    map_tracks_.push_back({tracks_[i].pixel, matches[i].status == KltStatus::kTracked});
   }
-  if (dropouts_.Skip(map_tracks, grey.size(), options_.min_points)) {
+  if (dropouts_.Skip(map_tracks_, grey.size(), options_.min_points)) {
     result.state = TrackingState::kLost;
     result.dropout = true;
     result.klt_tracked = dropouts_.found();

@@ -161,6 +161,7 @@ class Tracker {
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
   ImageDropouts dropouts_{options_};
+  std::vector<ImageDropouts::LiveTrack> map_tracks_;  // the dropout rule's input, re-filled every frame
   // By point id: how far the last frame's tracking moved it (with deformation_motion_seed;
   // during the deformation stage, where each point started).
   std::vector<Eigen::Vector3d> point_motion_;
