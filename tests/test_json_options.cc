@@ -126,9 +126,10 @@ TEST(JsonOptions, DropoutShareIsAFraction) {
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").min_tracked_fraction, 0.0);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"min_tracked_fraction=1.5"}), Error);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"min_tracked_fraction=-0.1"}), Error);
-  const TrackingOptions by_cells = WithAssignments(TrackingOptions{}, {"dropout_tracks_per_cell=6"});
-  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(by_cells), "test").dropout_tracks_per_cell, 6);
-  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"dropout_tracks_per_cell=-1"}), Error);
+  const TrackingOptions strict = WithAssignments(TrackingOptions{}, {"dropout_min_match_ssim=1"});
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(strict), "test").dropout_min_match_ssim, 1.0);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"dropout_min_match_ssim=1.1"}), Error);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"dropout_min_match_ssim=-0.5"}), Error);
 }
 
 TEST(JsonOptions, DbaModelSelectionThresholdsAreValidatedAndRoundTrip) {

@@ -224,7 +224,8 @@ KltTracker::Photometric KltTracker::FitTrend(size_t slot, const Trend& current) 
   const Trend& reference = reference_trend_[slot];
   Photometric fit;
   fit.textured = current.deviation > 1e-3;
-  fit.gain = fit.textured ? std::clamp(static_cast<float>(reference.deviation / current.deviation), 0.2f, 5.f) : 1.f;
+  const auto ratio = static_cast<float>(reference.deviation / current.deviation);
+  fit.gain = fit.textured ? std::clamp(ratio, kKltMinGain, kKltMaxGain) : 1.f;
   fit.bias = static_cast<float>(reference.mean - fit.gain * current.mean);
   fit.slope_u = static_cast<float>(reference.slope_u - fit.gain * current.slope_u);
   fit.slope_v = static_cast<float>(reference.slope_v - fit.gain * current.slope_v);

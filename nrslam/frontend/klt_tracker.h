@@ -31,11 +31,16 @@ enum class KltStatus {
 };
 const char* ToString(KltStatus status);
 
+// The bounds of the fitted gain α. A window whose texture is much fainter or stronger than the
+// reference's (a near-black frame, noise) sits at one of them.
+inline constexpr float kKltMinGain = 0.2f;
+inline constexpr float kKltMaxGain = 5.f;
+
 struct KltResult {
   cv::Point2f position;
   KltStatus status = KltStatus::kLost;
   float ssim = 0.f;
-  float gain = 1.f;  // α
+  float gain = 1.f;  // α, in [kKltMinGain, kKltMaxGain]
   float bias = 0.f;  // β
 };
 

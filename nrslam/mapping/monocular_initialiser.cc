@@ -108,11 +108,11 @@ InitialisationAttempt MonocularInitialiser::Add(int frame, const cv::Mat& bgr, c
   std::vector<ImageDropouts::LiveTrack> live;
   for (size_t i = 0; i < history_.size(); ++i) {
     found[i] = alive_[i] && matches[i].status == KltStatus::kTracked && on_valid(matches[i].position);
-    if (alive_[i]) live.push_back({history_[i].back(), found[i]});
+    if (alive_[i]) live.push_back({found[i], matches[i].ssim, matches[i].gain});
   }
   // Counted before any track is cut, so that a skipped frame leaves the tracks as they were.
   // By the share alone: tracks that run out gradually restart the reference below, as before.
-  if (dropouts_.Skip(live, grey.size(), 0)) {
+  if (dropouts_.Skip(live, 0)) {
     InitialisationAttempt attempt;
     attempt.note = dropouts_.Note("tracks found", "");
     return attempt;

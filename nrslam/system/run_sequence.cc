@@ -186,7 +186,10 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         if (result.state == TrackingState::kLost) {
           summary.frames_dropout += result.dropout;
           log << "frame " << frame << ": lost (" << result.note << ")\n";
-        } else if (options.run.mapping) {
+        } else if (!result.note.empty()) {
+          log << "frame " << frame << ": " << result.note << '\n';
+        }
+        if (result.state == TrackingState::kTracking && options.run.mapping) {
           mapping = mapper.Process(result, bgr, mask, &tracker);
           result.cam_from_world = tracker.pose();  // the DBA may have refined it
           if (mapping.new_points > 0) log << "frame " << frame << ": " << mapping.new_points << " new points\n";
@@ -250,8 +253,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     if (tracked && !depth_problem.empty()) {
       // Tracked as if it were whole: only its score is missing, and the run says so.
       ++summary.frames_groundtruth_unreadable;
-      result.note = "not scored: " + depth_problem;
-      log << "frame " << frame << ": " << result.note << '\n';
+      const std::string not_scored = "not scored: " + depth_problem;
+      log << "frame " << frame << ": " << not_scored << '\n';
+      result.note = result.note.empty() ? not_scored : not_scored + "; " + result.note;
     }
     if (tracked) {
       trajectory.push_back({frame / reader.info().fps, result.cam_from_world.Inverse()});

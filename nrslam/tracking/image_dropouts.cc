@@ -1,53 +1,51 @@
 #include "nrslam/tracking/image_dropouts.h"
 
 #include <algorithm>
-#include <cmath>
+#include <cstdio>
 
 namespace nrslam {
 namespace {
 
-int Cell(float coordinate, int size, int grid) {
-  if (!std::isfinite(coordinate)) return 0;
-  return std::clamp(static_cast<int>(std::floor(coordinate * grid / size)), 0, grid - 1);
+float Median(std::vector<float>* values) {
+  if (values->empty()) return 0;
+  const auto middle = values->begin() + static_cast<std::ptrdiff_t>(values->size() / 2);
+  std::nth_element(values->begin(), middle, values->end());
+  return *middle;
 }
 
 }  // namespace
 
-bool ImageDropouts::Skip(const std::vector<LiveTrack>& tracks, cv::Size image_size, int min_found) {
+bool ImageDropouts::Skip(const std::vector<LiveTrack>& tracks, int min_found) {
+  found_ssim_.clear();
+  found_gain_.clear();
+  for (const LiveTrack& track : tracks) {
+    if (!track.found) continue;
+    found_ssim_.push_back(track.ssim);
+    found_gain_.push_back(track.gain);
+  }
   live_ = static_cast<int>(tracks.size());
-  found_ = static_cast<int>(std::count_if(tracks.begin(), tracks.end(), [](const LiveTrack& t) { return t.found; }));
-  counted_ = CountedLive(tracks, image_size);
-  const bool too_few =
-      found_ < min_found || (min_fraction_ > 0 && live_ > 0 && (found_ == 0 || found_ < min_fraction_ * counted_));
-  in_a_row_ = too_few && in_a_row_ < max_in_a_row_ ? in_a_row_ + 1 : 0;
+  found_ = static_cast<int>(found_ssim_.size());
+  median_ssim_ = Median(&found_ssim_);
+  median_gain_ = Median(&found_gain_);
+  under_share_ = min_fraction_ > 0 && live_ > 0 && found_ < min_fraction_ * live_;
+  // A median at a bound means more than half of the found tracks needed the most correction the
+  // fit allows: their windows hold much fainter or stronger texture than the references.
+  match_well_ =
+      found_ > 0 && median_ssim_ > min_match_ssim_ && median_gain_ > kKltMinGain && median_gain_ < kKltMaxGain;
+  too_few_ = found_ < min_found || (under_share_ && !match_well_);
+  in_a_row_ = too_few_ && in_a_row_ < max_in_a_row_ ? in_a_row_ + 1 : 0;
   return in_a_row_ > 0;
 }
 
-int ImageDropouts::CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size) {
-  const int grid =
-      tracks_per_cell_ > 0
-          ? std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(tracks.size()) / tracks_per_cell_))))
-          : 1;
-  live_in_cell_.assign(grid * grid, 0);  // every frame: the buffers keep their capacity
-  found_in_cell_.assign(grid * grid, false);
-  for (const LiveTrack& track : tracks) {
-    const int cell =
-        Cell(track.last_pixel.y, image_size.height, grid) * grid + Cell(track.last_pixel.x, image_size.width, grid);
-    ++live_in_cell_[cell];
-    if (track.found) found_in_cell_[cell] = true;
-  }
-  int counted = 0;
-  for (size_t cell = 0; cell < live_in_cell_.size(); ++cell) counted += found_in_cell_[cell] ? live_in_cell_[cell] : 0;
-  return counted;
-}
-
 std::string ImageDropouts::Note(const std::string& counted, const std::string& kept) const {
-  std::string share;
-  if (counted_ > 0 && counted_ < live_) {  // none found: no part of the image to name
-    share = std::to_string(found_) + " of the " + std::to_string(counted_) + " where any were found; ";
-  }
-  return "only " + std::to_string(found_) + " of " + std::to_string(live_) + " " + counted +
-         ": skipped as an image dropout" + kept + " (" + share + std::to_string(in_a_row_) + " of at most " +
+  if (!too_few_ && !under_share_) return "";
+  std::string text = "only " + std::to_string(found_) + " of " + std::to_string(live_) + " " + counted;
+  char scores[64] = "";
+  if (found_ > 0) std::snprintf(scores, sizeof scores, " (median SSIM %.2f, gain %.2f)", median_ssim_, median_gain_);
+  if (!too_few_) return text + ", but they match well" + scores + ": the view partly hidden, the frame used";
+  text += scores;
+  if (in_a_row_ == 0) return text + ": used, the allowance of " + std::to_string(max_in_a_row_) + " dropouts in a row spent";
+  return text + ": skipped as an image dropout" + kept + " (" + std::to_string(in_a_row_) + " of at most " +
          std::to_string(max_in_a_row_) + " in a row)";
 }
 

@@ -6,58 +6,58 @@
 // used again whatever they hold.
 #pragma once
 
-#include <opencv2/core/types.hpp>
-
 #include <string>
 #include <vector>
 
+#include "nrslam/frontend/klt_tracker.h"
 #include "nrslam/tracking/tracking_options.h"
 
 namespace nrslam {
 
 class ImageDropouts {
  public:
-  // A track alive before this frame: where it was last, and whether the KLT found it now.
+  // A track alive before this frame: whether the KLT found it now, and if so how well it
+  // matched (KltResult::ssim and gain).
   struct LiveTrack {
-    cv::Point2f last_pixel;
     bool found;
+    float ssim;
+    float gain;
   };
 
   explicit ImageDropouts(const TrackingOptions& options)
       : max_in_a_row_(options.max_dropout_frames),
         min_fraction_(options.min_tracked_fraction),
-        tracks_per_cell_(options.dropout_tracks_per_cell) {}
+        min_match_ssim_(options.dropout_min_match_ssim) {}
 
-  // Whether to skip a frame of `image_size` on which the KLT found fewer than `min_found` of
-  // the live tracks, or (with a min_tracked_fraction) none, or fewer than that fraction of those
-  // it counts, while the allowance lasts. It counts the live tracks in the cells of a grid over
-  // the image that hold a found one, the grid holding about dropout_tracks_per_cell live tracks
-  // a cell: noise lets a few chance tracks through all over the image and leaves nearly every
-  // track counted, whereas an instrument or a mask over part of the view takes the tracks it
-  // hides out of the count. A skip is counted; a frame used ends the run of skips.
-  bool Skip(const std::vector<LiveTrack>& tracks, cv::Size image_size, int min_found);
+  // Whether to skip a frame on which the KLT found fewer than `min_found` of the live tracks,
+  // or (with a min_tracked_fraction) none, or fewer than that fraction of them while those it
+  // found match like chance: their median SSIM at most dropout_min_match_ssim, or their median
+  // gain at one of the KLT's bounds. The found tracks of a view that an instrument partly hides
+  // match as well as on an intact frame, and such a frame is used. A skip is counted, up to the
+  // allowance; a frame used ends the run of skips.
+  bool Skip(const std::vector<LiveTrack>& tracks, int min_found);
   void Reset() { in_a_row_ = 0; }
 
   // The tracks found on the last frame given to Skip.
   int found() const { return found_; }
 
-  // The last skipped frame's note: "only 11 of 119 points tracked: skipped as an image dropout,
-  // the map kept (1 of at most 5 in a row)" for counted = "points tracked", kept = ", the map
-  // kept"; when the share counted some but not all of them, "(11 of the 100 where any were found;
-  // 1 of at most 5 in a row)".
+  // The last frame's note, for counted = "points tracked", kept = ", the map kept". Skipped:
+  // "only 11 of 119 points tracked (median SSIM 0.80, gain 0.20): skipped as an image dropout,
+  // the map kept (1 of at most 5 in a row)". Used under the share: "only 60 of 187 points
+  // tracked, but they match well (median SSIM 0.97, gain 0.93): the view partly hidden, the frame
+  // used". Used once the allowance is spent: "... (median SSIM 0.80, gain 0.20): used, the
+  // allowance of 5 dropouts in a row spent". Empty for a frame with enough tracks.
   std::string Note(const std::string& counted, const std::string& kept) const;
 
  private:
-  // The live tracks in the cells that hold a found one.
-  int CountedLive(const std::vector<LiveTrack>& tracks, cv::Size image_size);
-
   int max_in_a_row_;
   double min_fraction_;
-  int tracks_per_cell_;
+  double min_match_ssim_;
   int in_a_row_ = 0;
-  int live_ = 0, found_ = 0, counted_ = 0;
-  std::vector<int> live_in_cell_;
-  std::vector<bool> found_in_cell_;
+  int live_ = 0, found_ = 0;
+  bool under_share_ = false, match_well_ = false, too_few_ = false;
+  float median_ssim_ = 0, median_gain_ = 1;
+  std::vector<float> found_ssim_, found_gain_;  // re-filled every frame: they keep their capacity
 };
 
 }  // namespace nrslam

@@ -575,13 +575,14 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   map_tracks_.clear();
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active || tracks_[i].id == kNoPoint) continue;
-    map_tracks_.push_back({tracks_[i].pixel, matches[i].status == KltStatus::kTracked});
+    map_tracks_.push_back({matches[i].status == KltStatus::kTracked, matches[i].ssim, matches[i].gain});
   }
-  if (dropouts_.Skip(map_tracks_, grey.size(), options_.min_points)) {
+  const bool dropout = dropouts_.Skip(map_tracks_, options_.min_points);
+  result.note = dropouts_.Note("points tracked", ", the map kept");
+  if (dropout) {
     result.state = TrackingState::kLost;
     result.dropout = true;
     result.klt_tracked = dropouts_.found();
-    result.note = dropouts_.Note("points tracked", ", the map kept");
     result.ms_klt = MillisecondsSince(start);
     result.ms_total = result.ms_klt;
     return result;

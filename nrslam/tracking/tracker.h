@@ -63,7 +63,7 @@ struct FrameResult {
   // Inside ms_deformation: Ceres's time in the joint solves (all rounds), and the part of it
   // spent in the linear solver (factorising or CG), which is where deformable tracking's time goes.
   double ms_joint_solve = 0, ms_linear_solve = 0;
-  std::string note;                  // why a frame is not tracked
+  std::string note;                  // why a frame is not tracked, or what was unusual about a tracked one
   // Not tracked, as an image dropout: the tracker kept its map and tracks and will try the next
   // frame (TrackingOptions::max_dropout_frames); state() is still kTracking.
   bool dropout = false;

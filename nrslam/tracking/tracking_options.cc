@@ -11,7 +11,8 @@ void TrackingOptions::Check() const {
   CheckOption(max_dropout_frames >= 0, "tracking", "max_dropout_frames must be >= 0 (0: a dropout is lost at once)");
   CheckOption(min_tracked_fraction >= 0 && min_tracked_fraction <= 1, "tracking",
               "min_tracked_fraction must be in [0, 1]");
-  CheckOption(dropout_tracks_per_cell >= 0, "tracking", "dropout_tracks_per_cell must be >= 0 (0: the whole image)");
+  CheckOption(dropout_min_match_ssim >= 0 && dropout_min_match_ssim <= 1, "tracking",
+              "dropout_min_match_ssim must be in [0, 1] (1: every frame under min_tracked_fraction is a dropout)");
   CheckOption(pose_rounds >= 1 && pose_iterations >= 1 && deformation_rounds >= 1 && deformation_iterations >= 1,
               "tracking", "rounds and iterations must be >= 1");
   CheckOption(joint_linear_solver == "sparse_cholesky" || joint_linear_solver == "cgnr", "tracking",

@@ -23,14 +23,12 @@ struct TrackingOptions {
   // no pose fits. A tracked frame of the simulated suites keeps ≥ 89 % of them. 0: only
   // min_points decides.
   double min_tracked_fraction = 0.5;
-  // With N > 0, counted only over the parts of the image where any track was found: the cells,
-  // holding about N live tracks each, of a square grid that hold one. Then an instrument or a
-  // mask that hides most of the tracks does not make a frame a dropout, while noise, whose few
-  // chance tracks are spread over the image, still does, by a thinner margin (the largest share
-  // of a noise frame measured: 0.47 at N = 6, against 0.26 over the whole image; README,
-  // "Sequence format"). 0: over the whole image, so that noise is never tracked; 6 suits
-  // footage with instruments.
-  int dropout_tracks_per_cell = 0;
+  // A frame under that share is still used when the tracks found match well: their median
+  // SSIM (after the KLT's light correction) above this, and their median gain α inside the
+  // KLT's bounds. Then the view is partly hidden (an instrument, a mask) and the tracks left are
+  // right; on noise the chance matches scored a median SSIM of 0.79–0.82 with α at a bound,
+  // on a view 60 % hidden 0.92–0.99 (README, "Sequence format"). 1: every such frame skipped.
+  double dropout_min_match_ssim = 0.88;
   int pose_rounds = 3;                // rigid pose-only refinement: outlier rounds ...
   int pose_iterations = 10;           // ... of this many LM iterations each
   double pose_sigma_px = 1.0;         // σ of the rigid refinement's reprojection residuals
@@ -71,7 +69,7 @@ struct TrackingOptions {
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
-                                                max_dropout_frames, min_tracked_fraction, dropout_tracks_per_cell,
+                                                max_dropout_frames, min_tracked_fraction, dropout_min_match_ssim,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
                                                 deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
                                                 displacement_prior_sigma, deformation_motion_seed,
