@@ -1,19 +1,10 @@
 #include "nrslam/tracking/image_dropouts.h"
 
-#include <algorithm>
 #include <cstdio>
 
+#include "nrslam/util/median.h"
+
 namespace nrslam {
-namespace {
-
-float Median(std::vector<float>* values) {
-  if (values->empty()) return 0;
-  const auto middle = values->begin() + static_cast<std::ptrdiff_t>(values->size() / 2);
-  std::nth_element(values->begin(), middle, values->end());
-  return *middle;
-}
-
-}  // namespace
 
 bool ImageDropouts::Skip(const std::vector<LiveTrack>& tracks, int min_found) {
   found_ssim_.clear();
@@ -25,8 +16,8 @@ bool ImageDropouts::Skip(const std::vector<LiveTrack>& tracks, int min_found) {
   }
   live_ = static_cast<int>(tracks.size());
   found_ = static_cast<int>(found_ssim_.size());
-  median_ssim_ = Median(&found_ssim_);
-  median_gain_ = Median(&found_gain_);
+  median_ssim_ = found_ > 0 ? MedianInPlace(&found_ssim_) : 0.f;
+  median_gain_ = found_ > 0 ? MedianInPlace(&found_gain_) : 1.f;
   under_share_ = min_fraction_ > 0 && live_ > 0 && found_ < min_fraction_ * live_;
   // A median at a bound means more than half of the found tracks needed the most correction the
   // fit allows: their windows hold much fainter or stronger texture than the references.
