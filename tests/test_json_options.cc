@@ -121,6 +121,13 @@ TEST(JsonOptions, DisplacementPriorIsOffByDefaultAndNeverNegative) {
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"displacement_prior_sigma=-0.2"}), Error);
 }
 
+TEST(JsonOptions, ReassociationConsensusIsACount) {
+  const TrackingOptions on = WithAssignments(TrackingOptions{}, {"reassociation_consensus_k=4"});
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(on), "test").reassociation_consensus_k, 4);
+  EXPECT_EQ(TrackingOptions{}.reassociation_consensus_k, 0);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"reassociation_consensus_k=-1"}), Error);
+}
+
 TEST(JsonOptions, DropoutShareIsAFraction) {
   const TrackingOptions off = WithAssignments(TrackingOptions{}, {"min_tracked_fraction=0"});
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").min_tracked_fraction, 0.0);

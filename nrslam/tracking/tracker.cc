@@ -265,34 +265,81 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
     if (added) groups.emplace_back(lost.patch.keyframe.get(), Candidates{});
     groups[it->second].second.emplace_back(id, *pixel);
   }
-  KltOptions search = frontend_.klt;
-  search.levels = std::min(search.levels, options_.reassociation_levels);  // the seed is close
+  KltOptions near_search = frontend_.klt;
+  near_search.levels = std::min(near_search.levels, options_.reassociation_levels);  // the seed is close
+  const bool search_far = options_.reassociation_consensus_k > 0;
+  std::vector<FoundAgain> near, far;
   for (const auto& [keyframe, candidates] : groups) {
     std::vector<cv::Point2f> patches, seeds;
     for (const auto& [id, projection] : candidates) {
       patches.push_back(lost_.at(id).patch.pixel);
       seeds.emplace_back(static_cast<float>(projection.x()), static_cast<float>(projection.y()));
     }
-    KltTracker klt(search);
+    KltTracker klt(near_search);
     klt.SetReference(*keyframe, patches);
     std::vector<KltResult> found;
     klt.Track(pyramid, seeds, frontend_.klt.ssim_reassociation, &found);
+    std::vector<cv::Point2f> missed_patches, missed_seeds;
+    std::vector<PointId> missed;
     for (size_t i = 0; i < candidates.size(); ++i) {
       const cv::Point2f offset = found[i].position - seeds[i];
-      if (found[i].status != KltStatus::kTracked ||
-          offset.dot(offset) > options_.reassociation_gate_px2) {
-        continue;
+      if (found[i].status == KltStatus::kTracked && offset.dot(offset) <= options_.reassociation_gate_px2) {
+        near.push_back({candidates[i].first, seeds[i], found[i].position});
+      } else if (search_far) {
+        missed.push_back(candidates[i].first);
+        missed_patches.push_back(patches[i]);
+        missed_seeds.push_back(seeds[i]);
       }
-      const PointId id = candidates[i].first;
-      const PatchSource patch = lost_.at(id).patch;
-      klt_.Append(*patch.keyframe, {patch.pixel});
-      tracks_.push_back({id, next_track_id_++, found[i].position, klt_.has_reference(klt_.size() - 1), patch});
-      lost_.erase(id);
-      if (!tracks_.back().active) continue;
-      result->points.push_back({id, found[i].position, true});
-      ++result->reassociated;
+    }
+    if (missed.empty()) continue;
+    KltTracker full_pyramid(frontend_.klt);
+    full_pyramid.SetReference(*keyframe, missed_patches);
+    full_pyramid.Track(pyramid, missed_seeds, frontend_.klt.ssim_reassociation, &found);
+    for (size_t i = 0; i < missed.size(); ++i) {
+      if (found[i].status == KltStatus::kTracked) far.push_back({missed[i], missed_seeds[i], found[i].position});
     }
   }
+  std::vector<FoundAgain> accepted = std::move(near);
+  const size_t near_count = accepted.size();
+  for (size_t i = 0; i < far.size(); ++i) {
+    if (MovedWithItsNeighbours(i, far, accepted, near_count)) accepted.push_back(far[i]);
+  }
+  for (const FoundAgain& point : accepted) {
+    const PatchSource patch = lost_.at(point.id).patch;
+    klt_.Append(*patch.keyframe, {patch.pixel});
+    tracks_.push_back({point.id, next_track_id_++, point.pixel, klt_.has_reference(klt_.size() - 1), patch});
+    lost_.erase(point.id);
+    if (!tracks_.back().active) continue;
+    result->points.push_back({point.id, point.pixel, true});
+    ++result->reassociated;
+  }
+}
+
+bool Tracker::MovedWithItsNeighbours(size_t index, const std::vector<FoundAgain>& far,
+                                     const std::vector<FoundAgain>& accepted, size_t near_count) {
+  const FoundAgain& point = far[index];
+  consensus_.clear();  // squared distance between projections, the neighbour's offset
+  const auto add = [&](const FoundAgain& other) {
+    const cv::Point2f apart = other.projection - point.projection;
+    consensus_.emplace_back(apart.dot(apart), other.pixel - other.projection);
+  };
+  for (size_t j = 0; j < near_count; ++j) add(accepted[j]);
+  for (size_t j = 0; j < far.size(); ++j) {
+    if (j != index) add(far[j]);
+  }
+  const auto k = static_cast<size_t>(options_.reassociation_consensus_k);
+  if (consensus_.size() < k) return false;
+  std::partial_sort(consensus_.begin(), consensus_.begin() + static_cast<std::ptrdiff_t>(k), consensus_.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  offsets_x_.clear();
+  offsets_y_.clear();
+  for (size_t j = 0; j < k; ++j) {
+    offsets_x_.push_back(consensus_[j].second.x);
+    offsets_y_.push_back(consensus_[j].second.y);
+  }
+  const cv::Point2f from_theirs =
+      point.pixel - point.projection - cv::Point2f(MedianInPlace(&offsets_x_), MedianInPlace(&offsets_y_));
+  return from_theirs.dot(from_theirs) <= options_.reassociation_gate_px2;
 }
 
 std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observations,

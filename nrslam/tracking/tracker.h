@@ -135,6 +135,12 @@ class Tracker {
     PatchSource patch;
     int lost_frame;
   };
+  // A lost point the re-association's KLT found: where its map position projects, and where
+  // the KLT found it.
+  struct FoundAgain {
+    PointId id;
+    cv::Point2f projection, pixel;
+  };
   struct Observation {
     size_t track;   // index into tracks_
     PointId id;
@@ -157,6 +163,9 @@ class Tracker {
   KltTracker klt_;
   std::vector<PointTrack> tracks_;  // aligned with the KLT's reference points
   std::unordered_map<PointId, LostPoint> lost_;  // moved with their neighbours; may be found again
+  // MovedWithItsNeighbours's buffers, re-filled for every point it is asked about.
+  std::vector<std::pair<float, cv::Point2f>> consensus_;
+  std::vector<float> offsets_x_, offsets_y_;
   TrackingState state_ = TrackingState::kNotInitialised;
   Rigid3 cam_from_world_;
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
@@ -217,6 +226,11 @@ class Tracker {
   void ForgetLostPoints(int frame);
   // Looks for lost points near their projection; found ones become tracks again.
   void Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, FrameResult* result);
+  // Whether far[index], found beyond the gate of its projection, is within the gate of the
+  // median offset of the reassociation_consensus_k points found nearest it this frame: the
+  // near ones (accepted[0, near_count)) and the other far ones.
+  bool MovedWithItsNeighbours(size_t index, const std::vector<FoundAgain>& far,
+                              const std::vector<FoundAgain>& accepted, size_t near_count);
   FrameResult Lost(FrameResult result, const std::string& why);
 };
 

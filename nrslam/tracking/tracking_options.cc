@@ -22,6 +22,7 @@ void TrackingOptions::Check() const {
   CheckOption(pose_sigma_px > 0 && outlier_chi2 > 0 && displacement_iqr_factor > 0, "tracking",
               "sigma, chi2 and IQR factor must be > 0");
   CheckOption(displacement_prior_sigma >= 0, "tracking", "displacement_prior_sigma must be >= 0 (0: no prior)");
+  CheckOption(reassociation_consensus_k >= 0, "tracking", "reassociation_consensus_k must be >= 0 (0: the gate alone)");
   CheckOption(reassociation_levels >= 1 && reassociation_gate_px2 > 0 && lost_max_age_frames >= 1,
               "tracking", "reassociation_levels, reassociation_gate_px2 and lost_max_age_frames must be positive");
 }
