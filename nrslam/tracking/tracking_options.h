@@ -64,10 +64,10 @@ struct TrackingOptions {
   // pyramid, and taken when its offset from its projection is within the gate of the median
   // offset of the k points found nearest it this frame. Tissue an instrument hid for a few
   // frames went on moving, as its neighbours did, and comes back tens of px from where its
-  // points were left. Tracking a map from depth it tracks sim-3 with an instrument over 60 % of
-  // the view for 10 frames to the end (93 of 120 frames without), and takes sim-4, sim-6 and
-  // lap-lobes lower; with mapping it measured slightly worse over the 21 colon renderings
-  // (README, "Tracking"). 0: the gate alone.
+  // points were left. Tracking a map from depth, it keeps sim-3 with an instrument over 60 % of
+  // the view for 10 frames tracked to the end (93 of 120 frames without). Without occlusions it
+  // measured a little worse over the 21 colon renderings, from depth and monocular (README,
+  // "Tracking and the runner"), hence off by default. 0: the gate alone.
   int reassociation_consensus_k = 0;
   int lost_max_age_frames = 90;   // a point lost longer ago is neither moved nor looked for (bounds work)
   // When the caller hands Track the next frame's image, that frame's KLT runs on a second
