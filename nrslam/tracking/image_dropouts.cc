@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "nrslam/frontend/klt_tracker.h"
 #include "nrslam/util/median.h"
 
 namespace nrslam {
@@ -35,7 +36,9 @@ std::string ImageDropouts::Note(const std::string& counted, const std::string& k
   if (found_ > 0) std::snprintf(scores, sizeof scores, " (median SSIM %.2f, gain %.2f)", median_ssim_, median_gain_);
   if (!too_few_) return text + ", but they match well" + scores + ": the view partly hidden, the frame used";
   text += scores;
-  if (in_a_row_ == 0) return text + ": used, the allowance of " + std::to_string(max_in_a_row_) + " dropouts in a row spent";
+  if (in_a_row_ == 0) {
+    return text + ": used, the allowance of " + std::to_string(max_in_a_row_) + " dropouts in a row spent";
+  }
   return text + ": skipped as an image dropout" + kept + " (" + std::to_string(in_a_row_) + " of at most " +
          std::to_string(max_in_a_row_) + " in a row)";
 }

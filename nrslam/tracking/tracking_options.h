@@ -80,9 +80,10 @@ struct TrackingOptions {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_points, keyframe_period, min_points,
                                                 max_dropout_frames, min_tracked_fraction, dropout_min_match_ssim,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
-                                                deformation_iterations, joint_linear_solver, joint_trust_region, outlier_chi2, displacement_iqr_factor,
-                                                displacement_prior_sigma, deformation_motion_seed,
-                                                reassociation, reassociation_levels, reassociation_gate_px2, reassociation_consensus_k,
-                                                lost_max_age_frames, klt_lookahead)
+                                                deformation_iterations, joint_linear_solver, joint_trust_region,
+                                                outlier_chi2, displacement_iqr_factor, displacement_prior_sigma,
+                                                deformation_motion_seed, reassociation, reassociation_levels,
+                                                reassociation_gate_px2, reassociation_consensus_k, lost_max_age_frames,
+                                                klt_lookahead)
 
 }  // namespace nrslam
