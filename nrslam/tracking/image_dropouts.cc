@@ -22,9 +22,9 @@ bool ImageDropouts::Skip(const std::vector<LiveTrack>& tracks, int min_found) {
   under_share_ = min_fraction_ > 0 && live_ > 0 && found_ < min_fraction_ * live_;
   // A median at a bound means more than half of the found tracks needed the most correction the
   // fit allows: their windows hold much fainter or stronger texture than the references.
-  match_well_ =
+  const bool match_well =
       found_ > 0 && median_ssim_ > min_match_ssim_ && median_gain_ > kKltMinGain && median_gain_ < kKltMaxGain;
-  too_few_ = found_ < min_found || (under_share_ && !match_well_);
+  too_few_ = found_ < min_found || (under_share_ && !match_well);
   in_a_row_ = too_few_ && in_a_row_ < max_in_a_row_ ? in_a_row_ + 1 : 0;
   return in_a_row_ > 0;
 }

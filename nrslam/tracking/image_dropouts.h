@@ -54,7 +54,7 @@ class ImageDropouts {
   double min_match_ssim_;
   int in_a_row_ = 0;
   int live_ = 0, found_ = 0;
-  bool under_share_ = false, match_well_ = false, too_few_ = false;
+  bool under_share_ = false, too_few_ = false;
   float median_ssim_ = 0, median_gain_ = 1;
   std::vector<float> found_ssim_, found_gain_;  // re-filled every frame: they keep their capacity
 };

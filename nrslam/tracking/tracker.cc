@@ -299,10 +299,9 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
       if (found[i].status == KltStatus::kTracked) far.push_back({missed[i], missed_seeds[i], found[i].position});
     }
   }
-  std::vector<FoundAgain> accepted = std::move(near);
-  const size_t near_count = accepted.size();
-  for (size_t i = 0; i < far.size(); ++i) {
-    if (MovedWithItsNeighbours(i, far, accepted, near_count)) accepted.push_back(far[i]);
+  std::vector<FoundAgain> accepted = near;
+  for (const FoundAgain& point : far) {
+    if (MovedWithItsNeighbours(point, near, far)) accepted.push_back(point);
   }
   for (const FoundAgain& point : accepted) {
     const PatchSource patch = lost_.at(point.id).patch;
@@ -315,17 +314,15 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
   }
 }
 
-bool Tracker::MovedWithItsNeighbours(size_t index, const std::vector<FoundAgain>& far,
-                                     const std::vector<FoundAgain>& accepted, size_t near_count) {
-  const FoundAgain& point = far[index];
+bool Tracker::MovedWithItsNeighbours(const FoundAgain& point, const std::vector<FoundAgain>& near,
+                                     const std::vector<FoundAgain>& far) {
   consensus_.clear();  // squared distance between projections, the neighbour's offset
-  const auto add = [&](const FoundAgain& other) {
-    const cv::Point2f apart = other.projection - point.projection;
-    consensus_.emplace_back(apart.dot(apart), other.pixel - other.projection);
-  };
-  for (size_t j = 0; j < near_count; ++j) add(accepted[j]);
-  for (size_t j = 0; j < far.size(); ++j) {
-    if (j != index) add(far[j]);
+  for (const std::vector<FoundAgain>* found : {&near, &far}) {
+    for (const FoundAgain& other : *found) {
+      if (&other == &point) continue;
+      const cv::Point2f apart = other.projection - point.projection;
+      consensus_.emplace_back(apart.dot(apart), other.pixel - other.projection);
+    }
   }
   const auto k = static_cast<size_t>(options_.reassociation_consensus_k);
   if (consensus_.size() < k) return false;

@@ -226,11 +226,11 @@ class Tracker {
   void ForgetLostPoints(int frame);
   // Looks for lost points near their projection; found ones become tracks again.
   void Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, FrameResult* result);
-  // Whether far[index], found beyond the gate of its projection, is within the gate of the
-  // median offset of the reassociation_consensus_k points found nearest it this frame: the
-  // near ones (accepted[0, near_count)) and the other far ones.
-  bool MovedWithItsNeighbours(size_t index, const std::vector<FoundAgain>& far,
-                              const std::vector<FoundAgain>& accepted, size_t near_count);
+  // Whether `point` (one of `far`, found beyond the gate of its projection) is within the gate
+  // of the median offset of the reassociation_consensus_k others found nearest it this frame,
+  // within the gate (`near`) or beyond it (`far`).
+  bool MovedWithItsNeighbours(const FoundAgain& point, const std::vector<FoundAgain>& near,
+                              const std::vector<FoundAgain>& far);
   FrameResult Lost(FrameResult result, const std::string& why);
 };
 
