@@ -571,6 +571,7 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   damaged.frames_unreadable_after_init = 1;
   damaged.frames_groundtruth_unreadable = 2;
   damaged.frames_dropout = 3;
+  damaged.sudden_occlusions = 2;
   const RunResult fine = Result("sim-0", 0.1, 60);
   std::stringstream table;
   PrintResults({damaged, fine}, table);
@@ -580,8 +581,10 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
       << table.str();
   EXPECT_NE(table.str().find("sim-2: 3 frames skipped as image dropouts (lost; the map kept)"), std::string::npos)
       << table.str();
+  EXPECT_NE(table.str().find("sim-2: 2 sudden occlusions: most of the view hidden at once"), std::string::npos)
+      << table.str();
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
-  EXPECT_EQ(RunNotes(damaged).size(), 2u);
+  EXPECT_EQ(RunNotes(damaged).size(), 3u);
   EXPECT_TRUE(RunNotes(fine).empty());
   // The report's section of the run says the same.
   const auto folder = UniqueTempFolder("results_notes_report");
@@ -598,6 +601,8 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_EQ(read[1].frames_groundtruth_unreadable, 0);
   EXPECT_EQ(read[0].frames_dropout, 3);
   EXPECT_EQ(read[1].frames_dropout, 0);
+  EXPECT_EQ(read[0].sudden_occlusions, 2);
+  EXPECT_EQ(read[1].sudden_occlusions, 0);
 }
 
 // A run is "lost" when it leaves frames after its initialisation untracked, or ends without

@@ -34,7 +34,8 @@ TEST(ImageDropouts, ChanceMatchesUnderTheShareMakeADropout) {
 }
 
 // An instrument hides 5/8 of the view: 96 of 256 tracks are found, and they match as on an
-// intact frame. The frame is used, and the note says why; with the threshold at 1 it is skipped.
+// intact frame. The frame is used as a sudden occlusion, and the note says why; with the
+// threshold at 1 it is skipped.
 TEST(ImageDropouts, WellMatchedTracksOfAPartlyHiddenViewAreUsed) {
   const auto tracks = Tracks(96, 0.97f, 0.93f);
   ImageDropouts dropouts{TrackingOptions{}};
@@ -42,10 +43,12 @@ TEST(ImageDropouts, WellMatchedTracksOfAPartlyHiddenViewAreUsed) {
   EXPECT_EQ(dropouts.Note("points tracked", ", the map kept"),
             "only 96 of 256 points tracked, but they match well (median SSIM 0.97, gain 0.93): the view partly "
             "hidden, the frame used");
+  EXPECT_TRUE(dropouts.SuddenOcclusion());
   TrackingOptions strict;
   strict.dropout_min_match_ssim = 1;
   ImageDropouts skipping(strict);
   EXPECT_TRUE(skipping.Skip(tracks, 10));
+  EXPECT_FALSE(skipping.SuddenOcclusion());
   // The medians decide, not a few chance matches among the found tracks.
   auto mixed = tracks;
   int chance = 0;
@@ -68,6 +71,7 @@ TEST(ImageDropouts, NoTrackFoundIsADropoutUnlessTheShareRuleIsOff) {
             "only 0 of 256 tracks found: skipped as an image dropout (1 of at most 5 in a row)");
   EXPECT_FALSE(dropouts.Skip(Tracks(200, 0.99f, 0.95f), 0));
   EXPECT_EQ(dropouts.Note("tracks found", ""), "");
+  EXPECT_FALSE(dropouts.SuddenOcclusion());
   TrackingOptions off;
   off.min_tracked_fraction = 0;
   ImageDropouts count_only(off);
@@ -91,6 +95,7 @@ TEST(ImageDropouts, TheAllowanceRunsOutAndStartsAgain) {
   EXPECT_EQ(dropouts.Note("points tracked", ""),
             "only 52 of 256 points tracked (median SSIM 0.79, gain 0.20): used, the allowance of 2 dropouts in a row "
             "spent");
+  EXPECT_FALSE(dropouts.SuddenOcclusion());  // used for want of a choice, not for its matches
   EXPECT_TRUE(dropouts.Skip(noise, 10));
   EXPECT_FALSE(dropouts.Skip(intact, 10));
   EXPECT_TRUE(dropouts.Skip(noise, 10));

@@ -1295,6 +1295,8 @@ TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
   EXPECT_EQ(tracked.Status(), "ok");
   EXPECT_EQ(tracked.frames_dropout, 0);
   EXPECT_EQ(tracked.frames_tracked, 40);
+  EXPECT_EQ(tracked.sudden_occlusions, 1);  // counted once, on the frame it came
+  EXPECT_EQ(ReadJsonFile(folder / "tracked" / "summary.json").at("sudden_occlusions"), 1);
   const auto metrics = ReadCsv(folder / "tracked" / "metrics.csv");
   ASSERT_EQ(metrics.size(), 40u);
   for (int frame = 15; frame < 18; ++frame) EXPECT_EQ(metrics[static_cast<size_t>(frame)].at("state"), "tracking");
@@ -1308,6 +1310,7 @@ TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
   strict.tracking.dropout_min_match_ssim = 1;
   const RunSummary skipped = RunSequence(folder / "sequence", strict, folder / "skipped");
   EXPECT_EQ(skipped.frames_dropout, 3);
+  EXPECT_EQ(skipped.sudden_occlusions, 0);
 }
 
 // An instrument hides most of the view for ten frames while the tissue under it goes on

@@ -25,6 +25,7 @@ struct RunResult {
   int frames_unreadable_after_init = 0;   // of them, those after the first map started
   int frames_groundtruth_unreadable = 0;  // tracked frames not scored: their ground-truth file was unreadable
   int frames_dropout = 0;                 // frames lost as image dropouts, the map kept
+  int sudden_occlusions = 0;              // tracked frames that lost most of the view at once (RunSummary)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   double peak_memory_mb = -1;       // the run process's peak resident memory; negative: not recorded
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none

@@ -39,6 +39,12 @@ std::string DropoutText(int frames_dropout) {
          " (lost; the map kept)";
 }
 
+std::string OcclusionText(int sudden_occlusions) {
+  if (sudden_occlusions == 0) return "";
+  return std::to_string(sudden_occlusions) + (sudden_occlusions == 1 ? " sudden occlusion" : " sudden occlusions") +
+         ": most of the view hidden at once, the tracks left matching well (the frames used; metrics.csv notes them)";
+}
+
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
   return stop_frame >= 0 ? "lost" : "ok";
@@ -82,6 +88,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (!unreadable.empty()) text << '\n' << unreadable;
   const std::string dropouts = DropoutText(summary.frames_dropout);
   if (!dropouts.empty()) text << '\n' << dropouts;
+  const std::string occlusions = OcclusionText(summary.sudden_occlusions);
+  if (!occlusions.empty()) text << '\n' << occlusions;
   return text.str();
 }
 
@@ -163,6 +171,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_unreadable_after_init", summary.frames_unreadable_after_init},
                       {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
                       {"frames_dropout", summary.frames_dropout},
+                      {"sudden_occlusions", summary.sudden_occlusions},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},
                       {"peak_memory_mb", summary.peak_memory_mb > 0 ? nlohmann::json(summary.peak_memory_mb) : nlohmann::json()},

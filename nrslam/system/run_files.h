@@ -42,6 +42,9 @@ struct RunSummary {
   int frames_unreadable_after_init = 0;
   // Frames lost as image dropouts: skipped with the map kept (TrackingOptions::max_dropout_frames).
   int frames_dropout = 0;
+  // Frames tracked although most of the view was hidden at once (FrameResult::sudden_occlusion):
+  // one per occlusion, not per frame it lasts.
+  int sudden_occlusions = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)
   // The process's peak resident memory when the run ended (MB; util/memory_usage.h): the run's
   // own under nrslam_run and nrslam_eval, which give each sequence its own process. 0: not measured.
@@ -74,6 +77,10 @@ std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_un
 
 // "2 frames skipped as image dropouts (lost; the map kept)"; "" when none.
 std::string DropoutText(int frames_dropout);
+
+// "2 sudden occlusions: most of the view hidden at once, the tracks left matching well (the
+// frames used; metrics.csv notes them)"; "" when none.
+std::string OcclusionText(int sudden_occlusions);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked

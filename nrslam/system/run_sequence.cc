@@ -189,6 +189,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         } else if (!result.note.empty()) {
           log << "frame " << frame << ": " << result.note << '\n';
         }
+        summary.sudden_occlusions += result.sudden_occlusion;
         if (result.state == TrackingState::kTracking && options.run.mapping) {
           mapping = mapper.Process(result, bgr, mask, &tracker);
           result.cam_from_world = tracker.pose();  // the DBA may have refined it

@@ -39,6 +39,10 @@ class ImageDropouts {
 
   // The tracks found on the last frame given to Skip.
   int found() const { return found_; }
+  // Whether that frame was used although under the share, because its found tracks matched
+  // well: most of the view hidden at once (an instrument, fluid). Once per such occlusion, as
+  // the tracks it hides are lost and no longer count as live on the next frame.
+  bool SuddenOcclusion() const { return under_share_ && !too_few_; }
 
   // The last frame's note, for counted = "points tracked", kept = ", the map kept". Skipped:
   // "only 11 of 119 points tracked (median SSIM 0.80, gain 0.20): skipped as an image dropout,

@@ -623,6 +623,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   }
   const bool dropout = dropouts_.Skip(map_tracks_, options_.min_points);
   result.note = dropouts_.Note("points tracked", ", the map kept");
+  result.sudden_occlusion = dropouts_.SuddenOcclusion();
   if (dropout) {
     result.state = TrackingState::kLost;
     result.dropout = true;

@@ -67,6 +67,9 @@ struct FrameResult {
   // Not tracked, as an image dropout: the tracker kept its map and tracks and will try the next
   // frame (TrackingOptions::max_dropout_frames); state() is still kTracking.
   bool dropout = false;
+  // Tracked although most of the map's tracks vanished at once, because those left matched well
+  // (ImageDropouts::SuddenOcclusion).
+  bool sudden_occlusion = false;
 };
 
 // `motions` less their mean: the part of the points' motion the camera cannot take over. The
