@@ -122,9 +122,9 @@ TEST(JsonOptions, DisplacementPriorIsOffByDefaultAndNeverNegative) {
 }
 
 TEST(JsonOptions, ReassociationConsensusIsACount) {
-  const TrackingOptions on = WithAssignments(TrackingOptions{}, {"reassociation_consensus_k=4"});
-  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(on), "test").reassociation_consensus_k, 4);
-  EXPECT_EQ(TrackingOptions{}.reassociation_consensus_k, 0);
+  const TrackingOptions off = WithAssignments(TrackingOptions{}, {"reassociation_consensus_k=0"});
+  EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").reassociation_consensus_k, 0);
+  EXPECT_EQ(TrackingOptions{}.reassociation_consensus_k, 4);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"reassociation_consensus_k=-1"}), Error);
 }
 

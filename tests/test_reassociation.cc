@@ -97,7 +97,7 @@ TEST(Reassociation, TheConsensusOfNeighboursFindsMoreOfThemWhereTheyAre) {
   const OccluderRun run = RunWithOccluder(true, 4);
   EXPECT_EQ(run.frames_tracked, 29);
   ASSERT_GE(run.lost_under_occluder.size(), 30u);
-  // Measured: 58 of 116 against 38 by the gate alone, the worst 2.7 px from the truth.
+  // Measured: 58 of 116 against 38 by the gate alone, the worst 1.4 px from the truth.
   EXPECT_GE(4 * recovered(run), 5 * recovered(by_gate))
       << recovered(run) << " against " << recovered(by_gate) << " of " << run.lost_under_occluder.size();
   EXPECT_LT(run.worst_found_error_px, 3.0);

@@ -197,7 +197,10 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
     if (klt_.has_reference(i)) {
       tracks_[i].patch = {keyframe, tracks_[i].pixel};
     } else {
-      LoseTrack(&tracks_[i], frame);  // under the mask here; it may be seen again elsewhere
+      // Under the mask here (hidden), or at the image's edge; it may be seen again elsewhere.
+      const cv::Point2f& pixel = tracks_[i].pixel;
+      const bool inside = camera_.InImage(Eigen::Vector2d(pixel.x, pixel.y), frontend_.klt.window_px / 2 + 1);
+      LoseTrack(&tracks_[i], frame, inside && valid.at<uint8_t>(cvRound(pixel.y), cvRound(pixel.x)) == 0);
     }
   }
   frames_since_keyframe_ = 0;
@@ -211,11 +214,11 @@ void Tracker::RetireDroppedPoints(std::vector<PointId> in_use) {
   map_->graph().Retire(in_use, map_->size());
 }
 
-void Tracker::LoseTrack(PointTrack* track, int frame) {
+void Tracker::LoseTrack(PointTrack* track, int frame, bool hidden) {
   track->active = false;
   if (!track->patch.keyframe || track->id == kNoPoint) return;
   if (!options_.rigid && map_->graph().IsWeaklyConnected(track->id)) return;
-  lost_[track->id] = {track->patch, frame};
+  lost_[track->id] = {track->patch, frame, hidden};
 }
 
 int Tracker::PropagateMotion(const std::vector<std::optional<Eigen::Vector3d>>& optimised,
@@ -285,7 +288,7 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
       const cv::Point2f offset = found[i].position - seeds[i];
       if (found[i].status == KltStatus::kTracked && offset.dot(offset) <= options_.reassociation_gate_px2) {
         near.push_back({candidates[i].first, seeds[i], found[i].position});
-      } else if (search_far) {
+      } else if (search_far && lost_.at(candidates[i].first).hidden) {
         missed.push_back(candidates[i].first);
         missed_patches.push_back(patches[i]);
         missed_seeds.push_back(seeds[i]);
@@ -636,7 +639,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;
     if (matches[i].status != KltStatus::kTracked) {
-      LoseTrack(&tracks_[i], frame);
+      LoseTrack(&tracks_[i], frame, result.sudden_occlusion);
       continue;
     }
     tracks_[i].pixel = matches[i].position;

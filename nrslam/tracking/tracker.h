@@ -137,6 +137,10 @@ class Tracker {
   struct LostPoint {
     PatchSource patch;
     int lost_frame;
+    // Lost where the view was known to be hidden: on a sudden occlusion, or under the validity
+    // mask at a reference refresh. The tissue under it may go on moving, so the point can come
+    // back far from where the map expects it (TrackingOptions::reassociation_consensus_k).
+    bool hidden;
   };
   // A lost point the re-association's KLT found: where its map position projects, and where
   // the KLT found it.
@@ -206,7 +210,7 @@ class Tracker {
   // The next frame's KLT from the tracks as they are now (run beside this frame's solve).
   Lookahead RunAhead(const cv::Mat& next_bgr, const std::vector<cv::Point2f>& guesses, int reference_generation) const;
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
-  void LoseTrack(PointTrack* track, int frame);
+  void LoseTrack(PointTrack* track, int frame, bool hidden);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   // Each point is moved by its `start` δ (one per observation) before the fit.
   std::vector<bool> RefinePose(const std::vector<Observation>& observations, const std::vector<Eigen::Vector3d>& start,

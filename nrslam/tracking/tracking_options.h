@@ -60,15 +60,16 @@ struct TrackingOptions {
   bool reassociation = true;
   int reassociation_levels = 2;            // pyramid levels of that KLT (the seed is close)
   double reassociation_gate_px2 = 5.99;    // squared px between the found position and the projection
-  // With k > 0, a lost point not found within that gate is looked for again over the KLT's full
-  // pyramid, and taken when its offset from its projection is within the gate of the median
-  // offset of the k points found nearest it this frame. Tissue an instrument hid for a few
-  // frames went on moving, as its neighbours did, and comes back tens of px from where its
-  // points were left. Tracking a map from depth, it keeps sim-3 with an instrument over 60 % of
-  // the view for 10 frames tracked to the end (93 of 120 frames without). Without occlusions it
-  // measured a little worse over the 21 colon renderings, from depth and monocular (README,
-  // "Tracking and the runner"), hence off by default. 0: the gate alone.
-  int reassociation_consensus_k = 0;
+  // With k > 0, a point lost where the view was hidden (on a sudden occlusion, or under the
+  // validity mask at a reference refresh) and not found within that gate is looked for again
+  // over the KLT's full pyramid, and taken when its offset from its projection is within the
+  // gate of the median offset of the k points found nearest it this frame. Tissue an instrument
+  // hid for a few frames went on moving, as its neighbours did, and comes back tens of px from
+  // where its points were left. Tracking a map from depth, it keeps sim-3 with an instrument
+  // over 60 % of the view for 10 frames tracked to the end (93 of 120 frames without). Points
+  // lost otherwise are not searched so: their offset more often says the map position is stale
+  // (README, "Tracking and the runner"). 0: the gate alone.
+  int reassociation_consensus_k = 4;
   int lost_max_age_frames = 90;   // a point lost longer ago is neither moved nor looked for (bounds work)
   // When the caller hands Track the next frame's image, that frame's KLT runs on a second
   // thread while this frame's pose and deformation are solved (deformable mode only). The
