@@ -126,6 +126,9 @@ TEST(JsonOptions, ReassociationConsensusIsACount) {
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").reassociation_consensus_k, 0);
   EXPECT_EQ(TrackingOptions{}.reassociation_consensus_k, 4);
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"reassociation_consensus_k=-1"}), Error);
+  EXPECT_EQ(WithAssignments(TrackingOptions{}, {"hidden_recent_frames=0"}).hidden_recent_frames, 0);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"hidden_recent_frames=-1"}), Error);
+  EXPECT_THROW(WithAssignments(TrackingOptions{}, {"hidden_min_edge_fraction=0.5"}), Error);
 }
 
 TEST(JsonOptions, DropoutShareIsAFraction) {

@@ -103,16 +103,18 @@ class RunSequenceTest : public ::testing::Test {
     fs::copy(*base_ / "sequence", folder / "sequence", fs::copy_options::recursive);
     return folder;
   }
-  // A grey instrument shaft over the right three quarters of frames [first, end) of a 320×240
-  // sequence, hiding more than half of the view.
+  // A grey instrument shaft from the right edge of a frame of a 320×240 sequence, its tip at
+  // column `tip_x`.
+  static void PaintShaft(const fs::path& sequence, int frame, int tip_x) {
+    const fs::path file = sequence / "rgb" / FrameFileName(frame);
+    cv::Mat image = cv::imread(file.string());
+    const std::vector<cv::Point> shaft = {{tip_x, 50}, {320, 0}, {320, 240}, {tip_x, 190}};
+    cv::fillConvexPoly(image, shaft, cv::Scalar(120, 125, 130));
+    cv::imwrite(file.string(), image);
+  }
+  // The shaft over the right three quarters of frames [first, end), hiding more than half of the view.
   static void PaintInstrument(const fs::path& sequence, int first, int end) {
-    for (int frame = first; frame < end; ++frame) {
-      const fs::path file = sequence / "rgb" / FrameFileName(frame);
-      cv::Mat image = cv::imread(file.string());
-      const std::vector<cv::Point> shaft = {{80, 50}, {320, 0}, {320, 240}, {80, 190}};
-      cv::fillConvexPoly(image, shaft, cv::Scalar(120, 125, 130));
-      cv::imwrite(file.string(), image);
-    }
+    for (int frame = first; frame < end; ++frame) PaintShaft(sequence, frame, 80);
   }
   static fs::path* base_;
   static RunSummary* summary_;
@@ -1337,6 +1339,38 @@ TEST_F(RunSequenceTest, PointsAnInstrumentHidAreFoundAgainWhereTheirNeighboursMo
   const int by_gate = found_again("gate", 0);
   const int by_consensus = found_again("consensus", 4);
   EXPECT_GE(by_consensus, 2 * by_gate) << by_gate << " found again by the gate alone";
+}
+
+// The instrument slides in over 6 frames, 40 px a frame, stays 4 and leaves the same way: no
+// frame loses most of the view at once, but the points it covers are lost in a band that moves
+// across it. They are hidden (MarkHiddenLosses), and found again as they were above.
+TEST_F(RunSequenceTest, PointsAnInstrumentSlidingInHidAreFoundAgainToo) {
+  const fs::path folder = CopyOfSequence("sliding_instrument");
+  const int first = 12, steps = 6, hold = 4;
+  for (int step = 0; step < steps; ++step) {
+    const int tip_x = 320 - 40 * (step + 1);
+    PaintShaft(folder / "sequence", first + step, tip_x);
+    PaintShaft(folder / "sequence", first + 2 * steps + hold - 1 - step, tip_x);
+  }
+  for (int frame = first + steps; frame < first + steps + hold; ++frame) PaintShaft(folder / "sequence", frame, 80);
+  const int gone = first + 2 * steps + hold;
+  const auto found_again = [&](const std::string& name, int recent_frames) {
+    SystemOptions options = TrackingExperiment();
+    options.tracking.hidden_recent_frames = recent_frames;
+    const RunSummary summary = RunSequence(folder / "sequence", options, folder / name);
+    EXPECT_EQ(summary.frames_tracked, 40) << name;
+    EXPECT_EQ(summary.sudden_occlusions, 0) << name;
+    const auto metrics = ReadCsv(folder / name / "metrics.csv");
+    int count = 0;
+    for (int frame = gone - steps; frame < gone + 3 && frame < static_cast<int>(metrics.size()); ++frame) {
+      count += std::stoi(metrics[static_cast<size_t>(frame)].at("reassociated"));
+    }
+    return count;
+  };
+  const int by_gate = found_again("gate", 0);
+  const int hidden = found_again("hidden", TrackingExperiment().tracking.hidden_recent_frames);
+  // Measured: 7 by the gate, 31 with the hidden points' consensus, from the frame it starts to leave.
+  EXPECT_GE(hidden, 2 * by_gate) << by_gate << " found again by the gate alone";
 }
 
 // Where nothing hid the view, the consensus looks for no point beyond the gate: a point lost to

@@ -24,6 +24,19 @@
 namespace nrslam {
 namespace {
 
+// Moves the k entries of `by_distance` with the smallest .first (a squared distance) to its
+// front, nearest first; false when it holds fewer than k.
+template <typename Payload>
+bool SortNearest(std::vector<std::pair<float, Payload>>* by_distance, size_t k) {
+  if (by_distance->size() < k) return false;
+  std::partial_sort(by_distance->begin(), by_distance->begin() + static_cast<std::ptrdiff_t>(k), by_distance->end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  return true;
+}
+
+}  // namespace
+namespace {
+
 ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType solver) {
   ceres::Solver::Options options;
   options.max_num_iterations = iterations;
@@ -198,9 +211,7 @@ void Tracker::RefreshReference(int frame, std::shared_ptr<const ImagePyramid> ke
       tracks_[i].patch = {keyframe, tracks_[i].pixel};
     } else {
       // Under the mask here (hidden), or at the image's edge; it may be seen again elsewhere.
-      const cv::Point2f& pixel = tracks_[i].pixel;
-      const bool inside = camera_.InImage(Eigen::Vector2d(pixel.x, pixel.y), frontend_.klt.window_px / 2 + 1);
-      LoseTrack(&tracks_[i], frame, inside && valid.at<uint8_t>(cvRound(pixel.y), cvRound(pixel.x)) == 0);
+      LoseTrack(&tracks_[i], frame, UnderMask(valid, tracks_[i].pixel));
     }
   }
   frames_since_keyframe_ = 0;
@@ -214,11 +225,49 @@ void Tracker::RetireDroppedPoints(std::vector<PointId> in_use) {
   map_->graph().Retire(in_use, map_->size());
 }
 
+bool Tracker::UnderMask(const cv::Mat& valid, const cv::Point2f& pixel) const {
+  const bool inside = camera_.InImage(Eigen::Vector2d(pixel.x, pixel.y), frontend_.klt.window_px / 2 + 1);
+  return inside && valid.at<uint8_t>(cvRound(pixel.y), cvRound(pixel.x)) == 0;
+}
+
+void Tracker::MarkHiddenLosses(int frame) {
+  const auto k = static_cast<size_t>(options_.reassociation_consensus_k);
+  if (k == 0 || options_.hidden_recent_frames == 0 || lost_now_.empty()) return;
+  const auto inside = [&](const cv::Point2f& pixel, double margin) {
+    return camera_.InImage(Eigen::Vector2d(pixel.x, pixel.y), margin);
+  };
+  around_.clear();  // map points found this frame, and those lost lately where the KLT could see
+  for (const PointTrack& track : tracks_) {
+    if (track.active && track.id != kNoPoint) around_.emplace_back(track.pixel, false);
+  }
+  const double klt_margin = frontend_.klt.window_px / 2 + 1;
+  for (const auto& [id, lost] : lost_) {
+    if (frame - lost.lost_frame <= options_.hidden_recent_frames && inside(lost.pixel, klt_margin)) {
+      around_.emplace_back(lost.pixel, true);
+    }
+  }
+  const double edge_margin = options_.hidden_min_edge_fraction * std::min(camera_.width(), camera_.height());
+  for (PointId id : lost_now_) {
+    LostPoint& lost = lost_.at(id);
+    if (lost.hidden || !inside(lost.pixel, edge_margin)) continue;
+    nearest_.clear();
+    for (const auto& [pixel, lately_lost] : around_) {
+      const cv::Point2f apart = pixel - lost.pixel;
+      const float squared = apart.dot(apart);
+      if (squared > 0) nearest_.emplace_back(squared, lately_lost);  // not the point itself
+    }
+    if (!SortNearest(&nearest_, k)) continue;
+    size_t lately_lost = 0;
+    for (size_t j = 0; j < k; ++j) lately_lost += nearest_[j].second;
+    lost.hidden = 2 * lately_lost >= k;
+  }
+}
+
 void Tracker::LoseTrack(PointTrack* track, int frame, bool hidden) {
   track->active = false;
   if (!track->patch.keyframe || track->id == kNoPoint) return;
   if (!options_.rigid && map_->graph().IsWeaklyConnected(track->id)) return;
-  lost_[track->id] = {track->patch, frame, hidden};
+  lost_[track->id] = {track->patch, frame, track->pixel, hidden};
 }
 
 int Tracker::PropagateMotion(const std::vector<std::optional<Eigen::Vector3d>>& optimised,
@@ -328,9 +377,7 @@ bool Tracker::MovedWithItsNeighbours(const FoundAgain& point, const std::vector<
     }
   }
   const auto k = static_cast<size_t>(options_.reassociation_consensus_k);
-  if (consensus_.size() < k) return false;
-  std::partial_sort(consensus_.begin(), consensus_.begin() + static_cast<std::ptrdiff_t>(k), consensus_.end(),
-                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (!SortNearest(&consensus_, k)) return false;
   offsets_x_.clear();
   offsets_y_.clear();
   for (size_t j = 0; j < k; ++j) {
@@ -636,10 +683,13 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     return result;
   }
   std::vector<Observation> observations;
+  lost_now_.clear();
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;
     if (matches[i].status != KltStatus::kTracked) {
+      tracks_[i].pixel = guesses[i];  // where the KLT looked for it
       LoseTrack(&tracks_[i], frame, result.sudden_occlusion);
+      if (lost_.count(tracks_[i].id)) lost_now_.push_back(tracks_[i].id);
       continue;
     }
     tracks_[i].pixel = matches[i].position;
@@ -650,6 +700,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     observations.push_back({i, tracks_[i].id, Eigen::Vector2d(matches[i].position.x, matches[i].position.y)});
   }
   result.klt_tracked = static_cast<int>(observations.size());
+  MarkHiddenLosses(frame);
   result.ms_klt = MillisecondsSince(start);
   if (static_cast<int>(observations.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(observations.size()) + " points tracked");
@@ -701,7 +752,14 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   const bool refresh = frames_since_keyframe_ + 1 >= options_.keyframe_period;
   const bool search = options_.reassociation && !lost_.empty();
   if ((search || refresh) && valid.empty()) valid = BuildValidityMask(grey, mask, frontend_.masks);
-  if (search) Reassociate(*pyramid, valid, &result);
+  if (search) {
+    // A point the KLT lost where the mask now is was hidden, not lost to its own failure.
+    for (PointId id : lost_now_) {
+      const auto lost = lost_.find(id);  // not if forgotten since
+      if (lost != lost_.end() && UnderMask(valid, lost->second.pixel)) lost->second.hidden = true;
+    }
+    Reassociate(*pyramid, valid, &result);
+  }
   if (static_cast<int>(result.points.size()) < options_.min_points) {
     return Lost(result, "only " + std::to_string(result.points.size()) + " points left after outlier rejection");
   }

@@ -137,8 +137,10 @@ class Tracker {
   struct LostPoint {
     PatchSource patch;
     int lost_frame;
-    // Lost where the view was known to be hidden: on a sudden occlusion, or under the validity
-    // mask at a reference refresh. The tissue under it may go on moving, so the point can come
+    cv::Point2f pixel;  // where the KLT last looked for it (or, at a refresh, last found it)
+    // Lost where the view was hidden: on a sudden occlusion, together with its neighbours well
+    // inside the view (MarkHiddenLosses), or under the validity mask (where the KLT lost it, or at a
+    // reference refresh). The tissue under it may go on moving, so the point can come
     // back far from where the map expects it (TrackingOptions::reassociation_consensus_k).
     bool hidden;
   };
@@ -170,6 +172,11 @@ class Tracker {
   KltTracker klt_;
   std::vector<PointTrack> tracks_;  // aligned with the KLT's reference points
   std::unordered_map<PointId, LostPoint> lost_;  // moved with their neighbours; may be found again
+  std::vector<PointId> lost_now_;  // map points the KLT lost on this frame (re-filled every frame)
+  // MarkHiddenLosses's buffers: the map points around (pixel, lost lately) and, for one point,
+  // their squared distances to it.
+  std::vector<std::pair<cv::Point2f, bool>> around_;
+  std::vector<std::pair<float, bool>> nearest_;
   // MovedWithItsNeighbours's buffers, re-filled for every point it is asked about.
   std::vector<std::pair<float, cv::Point2f>> consensus_;
   std::vector<float> offsets_x_, offsets_y_;
@@ -211,6 +218,15 @@ class Tracker {
   Lookahead RunAhead(const cv::Mat& next_bgr, const std::vector<cv::Point2f>& guesses, int reference_generation) const;
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame, bool hidden);
+  // Whether `pixel`, well inside the image (not in its border), is invalid in `valid`: under the
+  // sequence's mask or a highlight.
+  bool UnderMask(const cv::Mat& valid, const cv::Point2f& pixel) const;
+  // Marks as hidden each map point the KLT lost on this frame well inside the image
+  // (hidden_min_edge_fraction) when at least half of the reassociation_consensus_k map points nearest it were
+  // lost too within the last hidden_recent_frames frames: something came over that part of the
+  // view (an instrument sliding in). A point lost alone, or at the image's edge as the view
+  // moves on, is not marked.
+  void MarkHiddenLosses(int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   // Each point is moved by its `start` δ (one per observation) before the fit.
   std::vector<bool> RefinePose(const std::vector<Observation>& observations, const std::vector<Eigen::Vector3d>& start,

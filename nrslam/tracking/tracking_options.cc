@@ -23,6 +23,8 @@ void TrackingOptions::Check() const {
               "sigma, chi2 and IQR factor must be > 0");
   CheckOption(displacement_prior_sigma >= 0, "tracking", "displacement_prior_sigma must be >= 0 (0: no prior)");
   CheckOption(reassociation_consensus_k >= 0, "tracking", "reassociation_consensus_k must be >= 0 (0: the gate alone)");
+  CheckOption(hidden_recent_frames >= 0 && hidden_min_edge_fraction >= 0 && hidden_min_edge_fraction < 0.5, "tracking",
+              "hidden_recent_frames must be >= 0 and hidden_min_edge_fraction in [0, 0.5)");
   CheckOption(reassociation_levels >= 1 && reassociation_gate_px2 > 0 && lost_max_age_frames >= 1,
               "tracking", "reassociation_levels, reassociation_gate_px2 and lost_max_age_frames must be positive");
 }
