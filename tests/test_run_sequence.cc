@@ -112,6 +112,19 @@ class RunSequenceTest : public ::testing::Test {
     cv::fillConvexPoly(image, shaft, cv::Scalar(120, 125, 130));
     cv::imwrite(file.string(), image);
   }
+  // Runs the copy in `folder` with `options` into folder / name, which must track every frame,
+  // and returns the points found again over frames [first, end) and the run's summary.
+  static std::pair<int, RunSummary> FoundAgain(const fs::path& folder, const std::string& name,
+                                               const SystemOptions& options, int first, int end) {
+    const RunSummary summary = RunSequence(folder / "sequence", options, folder / name);
+    EXPECT_EQ(summary.frames_tracked, 40) << name;
+    const auto metrics = ReadCsv(folder / name / "metrics.csv");
+    int count = 0;
+    for (int frame = first; frame < end && frame < static_cast<int>(metrics.size()); ++frame) {
+      count += std::stoi(metrics[static_cast<size_t>(frame)].at("reassociated"));
+    }
+    return {count, summary};
+  }
   // The shaft over the right three quarters of frames [first, end), hiding more than half of the view.
   static void PaintInstrument(const fs::path& sequence, int first, int end) {
     for (int frame = first; frame < end; ++frame) PaintShaft(sequence, frame, 80);
@@ -1325,14 +1338,8 @@ TEST_F(RunSequenceTest, PointsAnInstrumentHidAreFoundAgainWhereTheirNeighboursMo
   const auto found_again = [&](const std::string& name, int k) {
     SystemOptions options = TrackingExperiment();
     options.tracking.reassociation_consensus_k = k;
-    const RunSummary summary = RunSequence(folder / "sequence", options, folder / name);
-    EXPECT_EQ(summary.frames_tracked, 40) << name;
+    const auto [count, summary] = FoundAgain(folder, name, options, 25, 28);
     EXPECT_LT(summary.rmse_mm, 2.0) << name;
-    const auto metrics = ReadCsv(folder / name / "metrics.csv");
-    int count = 0;
-    for (int frame = 25; frame < 28 && frame < static_cast<int>(metrics.size()); ++frame) {
-      count += std::stoi(metrics[static_cast<size_t>(frame)].at("reassociated"));
-    }
     return count;
   };
   // Measured: 32 by the gate, 82 with the consensus, over the three frames after the instrument.
@@ -1357,14 +1364,8 @@ TEST_F(RunSequenceTest, PointsAnInstrumentSlidingInHidAreFoundAgainToo) {
   const auto found_again = [&](const std::string& name, int recent_frames) {
     SystemOptions options = TrackingExperiment();
     options.tracking.hidden_recent_frames = recent_frames;
-    const RunSummary summary = RunSequence(folder / "sequence", options, folder / name);
-    EXPECT_EQ(summary.frames_tracked, 40) << name;
+    const auto [count, summary] = FoundAgain(folder, name, options, gone - steps, gone + 3);
     EXPECT_EQ(summary.sudden_occlusions, 0) << name;
-    const auto metrics = ReadCsv(folder / name / "metrics.csv");
-    int count = 0;
-    for (int frame = gone - steps; frame < gone + 3 && frame < static_cast<int>(metrics.size()); ++frame) {
-      count += std::stoi(metrics[static_cast<size_t>(frame)].at("reassociated"));
-    }
     return count;
   };
   const int by_gate = found_again("gate", 0);
