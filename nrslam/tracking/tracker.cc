@@ -34,9 +34,6 @@ bool SortNearest(std::vector<std::pair<float, Payload>>* by_distance, size_t k) 
   return true;
 }
 
-}  // namespace
-namespace {
-
 ceres::Solver::Options SolverOptions(int iterations, ceres::LinearSolverType solver) {
   ceres::Solver::Options options;
   options.max_num_iterations = iterations;

@@ -139,9 +139,9 @@ class Tracker {
     int lost_frame;
     cv::Point2f pixel;  // where the KLT last looked for it (or, at a refresh, last found it)
     // Lost where the view was hidden: on a sudden occlusion, together with its neighbours well
-    // inside the view (MarkHiddenLosses), or under the validity mask (where the KLT lost it, or at a
-    // reference refresh). The tissue under it may go on moving, so the point can come
-    // back far from where the map expects it (TrackingOptions::reassociation_consensus_k).
+    // inside the view (MarkHiddenLosses), or under the validity mask (where the KLT lost it, or
+    // at a reference refresh). The tissue under it may go on moving, so the point can come back
+    // far from where the map expects it (TrackingOptions::reassociation_consensus_k).
     bool hidden;
   };
   // A lost point the re-association's KLT found: where its map position projects, and where
@@ -222,10 +222,10 @@ class Tracker {
   // sequence's mask or a highlight.
   bool UnderMask(const cv::Mat& valid, const cv::Point2f& pixel) const;
   // Marks as hidden each map point the KLT lost on this frame well inside the image
-  // (hidden_min_edge_fraction) when at least half of the reassociation_consensus_k map points nearest it were
-  // lost too within the last hidden_recent_frames frames: something came over that part of the
-  // view (an instrument sliding in). A point lost alone, or at the image's edge as the view
-  // moves on, is not marked.
+  // (hidden_min_edge_fraction) when at least half of the reassociation_consensus_k map points
+  // nearest it were lost too within the last hidden_recent_frames frames: something came over
+  // that part of the view (an instrument sliding in). A point lost alone, or at the image's
+  // edge as the view moves on, is not marked.
   void MarkHiddenLosses(int frame);
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   // Each point is moved by its `start` δ (one per observation) before the fit.
