@@ -223,7 +223,7 @@ void Tracker::RetireDroppedPoints(std::vector<PointId> in_use) {
 }
 
 bool Tracker::UnderMask(const cv::Mat& valid, const cv::Point2f& pixel) const {
-  const bool inside = camera_.InImage(Eigen::Vector2d(pixel.x, pixel.y), frontend_.klt.window_px / 2 + 1);
+  const bool inside = camera_.InImage(Eigen::Vector2d(pixel.x, pixel.y), WindowMargin());
   return inside && valid.at<uint8_t>(cvRound(pixel.y), cvRound(pixel.x)) == 0;
 }
 
@@ -237,9 +237,8 @@ void Tracker::MarkHiddenLosses(int frame) {
   for (const PointTrack& track : tracks_) {
     if (track.active && track.id != kNoPoint) around_.emplace_back(track.pixel, false);
   }
-  const double klt_margin = frontend_.klt.window_px / 2 + 1;
   for (const auto& [id, lost] : lost_) {
-    if (frame - lost.lost_frame <= options_.hidden_recent_frames && inside(lost.pixel, klt_margin)) {
+    if (frame - lost.lost_frame <= options_.hidden_recent_frames && inside(lost.pixel, WindowMargin())) {
       around_.emplace_back(lost.pixel, true);
     }
   }
@@ -302,7 +301,7 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
   // pixels (not under the mask, not in a highlight), grouped by the keyframe of their patch.
   // Groups keep the order they were first met in: ordered by address, found points would join
   // the tracks in an order that changes from run to run, and so would the results.
-  const double margin = frontend_.klt.window_px / 2 + 1;
+  const double margin = WindowMargin();
   using Candidates = std::vector<std::pair<PointId, Eigen::Vector2d>>;  // id, projection
   std::vector<std::pair<const ImagePyramid*, Candidates>> groups;
   std::unordered_map<const ImagePyramid*, size_t> group_of;

@@ -218,8 +218,10 @@ class Tracker {
   Lookahead RunAhead(const cv::Mat& next_bgr, const std::vector<cv::Point2f>& guesses, int reference_generation) const;
   // Stops tracking a point; unless the graph has cut it loose it may be found again later.
   void LoseTrack(PointTrack* track, int frame, bool hidden);
-  // Whether `pixel`, well inside the image (not in its border), is invalid in `valid`: under the
-  // sequence's mask or a highlight.
+  // How far from the image's edge a pixel must be for a whole KLT window around it to fit.
+  double WindowMargin() const { return frontend_.klt.window_px / 2 + 1; }
+  // Whether `pixel`, far enough inside the image for a KLT window (not in its border), is
+  // invalid in `valid`: under the sequence's mask or a highlight.
   bool UnderMask(const cv::Mat& valid, const cv::Point2f& pixel) const;
   // Marks as hidden each map point the KLT lost on this frame well inside the image
   // (hidden_min_edge_fraction) when at least half of the reassociation_consensus_k map points
