@@ -31,9 +31,9 @@ class ImageDropouts {
   // Whether to skip a frame on which the KLT found fewer than `min_found` of the live tracks,
   // or (with a min_tracked_fraction) none, or fewer than that fraction of them while those it
   // found match like chance: their median SSIM at most dropout_min_match_ssim, or their median
-  // gain at one of the KLT's bounds (kKltMinGain, kKltMaxGain). The found tracks of a view that an instrument partly hides
-  // match as well as on an intact frame, and such a frame is used. A skip is counted, up to the
-  // allowance; a frame used ends the run of skips.
+  // gain at one of the KLT's bounds (kKltMinGain, kKltMaxGain). The found tracks of a view that
+  // an instrument partly hides match as well as on an intact frame, and such a frame is used. A
+  // skip is counted, up to the allowance; a frame used ends the run of skips.
   bool Skip(const std::vector<LiveTrack>& tracks, int min_found);
   void Reset() { in_a_row_ = 0; }
 

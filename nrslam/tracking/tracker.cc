@@ -259,11 +259,12 @@ void Tracker::MarkHiddenLosses(int frame) {
   }
 }
 
-void Tracker::LoseTrack(PointTrack* track, int frame, bool hidden) {
+bool Tracker::LoseTrack(PointTrack* track, int frame, bool hidden) {
   track->active = false;
-  if (!track->patch.keyframe || track->id == kNoPoint) return;
-  if (!options_.rigid && map_->graph().IsWeaklyConnected(track->id)) return;
+  if (!track->patch.keyframe || track->id == kNoPoint) return false;
+  if (!options_.rigid && map_->graph().IsWeaklyConnected(track->id)) return false;
   lost_[track->id] = {track->patch, frame, track->pixel, hidden};
+  return true;
 }
 
 int Tracker::PropagateMotion(const std::vector<std::optional<Eigen::Vector3d>>& optimised,
@@ -347,18 +348,19 @@ void Tracker::Reassociate(const ImagePyramid& pyramid, const cv::Mat& valid, Fra
       if (found[i].status == KltStatus::kTracked) far.push_back({missed[i], missed_seeds[i], found[i].position});
     }
   }
-  std::vector<FoundAgain> accepted = near;
-  for (const FoundAgain& point : far) {
-    if (MovedWithItsNeighbours(point, near, far)) accepted.push_back(point);
-  }
-  for (const FoundAgain& point : accepted) {
+  // The consensus reads only the finds, so near ones can become tracks before far ones are judged.
+  const auto track_again = [&](const FoundAgain& point) {
     const PatchSource patch = lost_.at(point.id).patch;
     klt_.Append(*patch.keyframe, {patch.pixel});
     tracks_.push_back({point.id, next_track_id_++, point.pixel, klt_.has_reference(klt_.size() - 1), patch});
     lost_.erase(point.id);
-    if (!tracks_.back().active) continue;
+    if (!tracks_.back().active) return;
     result->points.push_back({point.id, point.pixel, true});
     ++result->reassociated;
+  };
+  for (const FoundAgain& point : near) track_again(point);
+  for (const FoundAgain& point : far) {
+    if (MovedWithItsNeighbours(point, near, far)) track_again(point);
   }
 }
 
@@ -684,8 +686,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     if (!tracks_[i].active) continue;
     if (matches[i].status != KltStatus::kTracked) {
       tracks_[i].pixel = guesses[i];  // where the KLT looked for it
-      LoseTrack(&tracks_[i], frame, result.sudden_occlusion);
-      if (lost_.count(tracks_[i].id)) lost_now_.push_back(tracks_[i].id);
+      if (LoseTrack(&tracks_[i], frame, result.sudden_occlusion)) lost_now_.push_back(tracks_[i].id);
       continue;
     }
     tracks_[i].pixel = matches[i].position;

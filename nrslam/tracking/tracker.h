@@ -216,8 +216,9 @@ class Tracker {
                                                      FrameSolution* solution, FrameResult* result);
   // The next frame's KLT from the tracks as they are now (run beside this frame's solve).
   Lookahead RunAhead(const cv::Mat& next_bgr, const std::vector<cv::Point2f>& guesses, int reference_generation) const;
-  // Stops tracking a point; unless the graph has cut it loose it may be found again later.
-  void LoseTrack(PointTrack* track, int frame, bool hidden);
+  // Stops tracking a point; unless the graph has cut it loose (or it is a candidate) it is kept
+  // among the lost points, which may be found again later: whether it was.
+  bool LoseTrack(PointTrack* track, int frame, bool hidden);
   // How far from the image's edge a pixel must be for a whole KLT window around it to fit.
   double WindowMargin() const { return frontend_.klt.window_px / 2 + 1; }
   // Whether `pixel`, far enough inside the image for a KLT window (not in its border), is
