@@ -131,6 +131,18 @@ TEST(JsonOptions, ReassociationConsensusIsACount) {
   EXPECT_THROW(WithAssignments(TrackingOptions{}, {"hidden_min_edge_fraction=0.5"}), Error);
 }
 
+TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
+  const FrontendOptions off = WithAssignments(FrontendOptions{}, {"masks.static_frames=0", "masks.static_min_edge=8"});
+  EXPECT_EQ(Json(OptionsFromJson<FrontendOptions>(Json(off), "test")), Json(off));
+  EXPECT_EQ(off.masks.static_frames, 0);
+  EXPECT_EQ(FrontendOptions{}.masks.static_frames, 24);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_frames=9"}), Error);  // too few to tell
+  EXPECT_EQ(WithAssignments(FrontendOptions{}, {"masks.static_frames=10"}).masks.static_frames, 10);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_max_change=256"}), Error);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_min_edge=-1"}), Error);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_margin_px=-1"}), Error);
+}
+
 TEST(JsonOptions, DropoutShareIsAFraction) {
   const TrackingOptions off = WithAssignments(TrackingOptions{}, {"min_tracked_fraction=0"});
   EXPECT_EQ(OptionsFromJson<TrackingOptions>(Json(off), "test").min_tracked_fraction, 0.0);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "frontend_fixtures.h"
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"
@@ -28,6 +30,75 @@ TEST(Masks, CombinesBorderHighlightsAndTheSequenceMaskThenErodes) {
   EXPECT_EQ(valid.at<uint8_t>(30, 97), 255);
   EXPECT_EQ(valid.at<uint8_t>(30, 110), 0);  // the sequence mask itself
   EXPECT_THROW(BuildValidityMask(grey, cv::Mat(10, 10, CV_8UC1), options), Error);
+}
+
+// 24 frames of 160×120: a blurred random texture moving 3 px right and 2 px down a frame, under
+// a black border (columns 0–11), a display's text, a flat grey square and a small white speck
+// that never change; frame 7 is a black dropout.
+struct StaticScene {
+  std::vector<cv::Mat> frames;
+  cv::Mat text;  // the display's strokes
+};
+StaticScene RenderStaticScene() {
+  cv::Mat texture(300, 400, CV_8UC1);
+  cv::RNG rng(7);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
+  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  StaticScene scene;
+  scene.text = cv::Mat::zeros(120, 160, CV_8UC1);
+  cv::putText(scene.text, "OSD 42", {40, 100}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255), 1);
+  for (int k = 0; k < 24; ++k) {
+    cv::Mat frame = texture(cv::Rect(3 * k, 2 * k, 160, 120)).clone();
+    frame.colRange(0, 12) = 0;
+    frame.setTo(200, scene.text);
+    frame(cv::Rect(110, 10, 24, 24)) = 128;
+    frame(cv::Rect(130, 80, 5, 5)) = 255;
+    if (k == 7) frame = 0;
+    scene.frames.push_back(frame);
+  }
+  return scene;
+}
+
+TEST(StaticRegions, FindsADisplayAndABlackBorderButNotMovingOrFlatTissue) {
+  const StaticScene scene = RenderStaticScene();
+  MaskOptions options;  // 4 grey levels, 64 px, an edge of 16 grey levels per px, a 10 px margin
+  const cv::Mat regions = FindStaticRegions(scene.frames, {}, options);
+  ASSERT_FALSE(regions.empty());
+  EXPECT_EQ(regions.at<uint8_t>(60, 5), 255);   // the border, through the dropout
+  EXPECT_EQ(regions.at<uint8_t>(60, 21), 255);  // its margin
+  EXPECT_EQ(regions.at<uint8_t>(60, 26), 0);
+  EXPECT_EQ(cv::countNonZero(regions & scene.text), cv::countNonZero(scene.text));  // the display
+  EXPECT_EQ(regions.at<uint8_t>(96, 48), 255);  // and the texture between its strokes, within the margin
+  EXPECT_EQ(regions.at<uint8_t>(60, 80), 0);  // moving tissue
+  EXPECT_EQ(regions.at<uint8_t>(22, 122), 0);  // still but flat: no edge to track
+  EXPECT_EQ(regions.at<uint8_t>(82, 132), 0);  // too small to be a display
+  // Each rule is what leaves its patch out.
+  options.static_min_edge = 0;
+  EXPECT_EQ(FindStaticRegions(scene.frames, {}, options).at<uint8_t>(22, 122), 255);
+  options.static_min_area_px = 0;
+  EXPECT_EQ(FindStaticRegions(scene.frames, {}, options).at<uint8_t>(82, 132), 255);
+}
+
+TEST(StaticRegions, LeavesWhatTheSequenceMasksAloneAndNeedsTenFramesOfOneSize) {
+  const StaticScene scene = RenderStaticScene();
+  cv::Mat sequence_mask(120, 160, CV_8UC1, cv::Scalar(255));
+  sequence_mask.colRange(0, 16) = 0;
+  const cv::Mat regions = FindStaticRegions(scene.frames, sequence_mask, MaskOptions{});
+  ASSERT_FALSE(regions.empty());
+  EXPECT_EQ(regions.at<uint8_t>(60, 5), 0);   // masked already: no news
+  EXPECT_EQ(regions.at<uint8_t>(60, 21), 0);  // and no margin grows from it
+  EXPECT_EQ(cv::countNonZero(regions & scene.text), cv::countNonZero(scene.text));
+  // Moving texture alone: nothing.
+  std::vector<cv::Mat> moving;
+  for (const cv::Mat& frame : scene.frames) moving.push_back(frame(cv::Rect(16, 0, 24, 80)).clone());
+  EXPECT_TRUE(FindStaticRegions(moving, {}, MaskOptions{}).empty());
+  const std::vector<cv::Mat> nine(scene.frames.begin(), scene.frames.begin() + 9);
+  EXPECT_THROW(FindStaticRegions(nine, {}, MaskOptions{}), Error);
+  std::vector<cv::Mat> mixed = scene.frames;
+  mixed[3] = cv::Mat(60, 80, CV_8UC1, cv::Scalar(0));
+  EXPECT_THROW(FindStaticRegions(mixed, {}, MaskOptions{}), Error);
+  EXPECT_THROW(FindStaticRegions(scene.frames, cv::Mat(10, 10, CV_8UC1), MaskOptions{}), Error);
 }
 
 TEST(Features, RenderedMucosaGivesManyCornersThatRespectMaskSpacingAndExclusion) {

@@ -141,6 +141,8 @@ TEST_F(RunSequenceTest, TracksEveryFrameAndBeatsAFrozenMapByFar) {
   EXPECT_EQ(summary_->frames_lost, 0);
   EXPECT_EQ(summary_->frames_evaluated, 40);
   EXPECT_LT(summary_->rmse_mm, 2.0);
+  EXPECT_EQ(summary_->static_fraction, 0);  // nothing in a rendering stays put
+  EXPECT_FALSE(fs::exists(*base_ / "run" / "static_mask.png"));
   // What a tracker that never moved would score: every tracked point at its initial depth.
   const SequenceReader reader(*base_ / "sequence");
   const std::vector<CsvPoint> points = ReadPointsCsv(*base_ / "run" / "points.csv");
@@ -1297,6 +1299,49 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
   SystemOptions count_only = TrackingExperiment();
   count_only.tracking.min_tracked_fraction = 0;
   ExpectLostFromFrame(folder, count_only, 15);
+}
+
+// An endoscope's on-screen display (grey text, not bright enough to pass for a highlight) on
+// every frame: corners on it would be tracked as points that move with the camera. The run finds
+// it static from 24 of its frames and leaves it out; with that off, the display is tracked.
+TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
+  const fs::path folder = CopyOfSequence("display");
+  cv::Mat strokes(240, 320, CV_8UC1, cv::Scalar(0));
+  cv::putText(strokes, "CV-190  ID 0042", {20, 40}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
+  cv::putText(strokes, "Eh:A3 Cm:1", {20, 205}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
+  for (int frame = 0; frame < 40; ++frame) {
+    const fs::path file = folder / "sequence" / "rgb" / FrameFileName(frame);
+    cv::Mat image = cv::imread(file.string());
+    image.setTo(cv::Scalar(150, 225, 150), strokes);
+    cv::imwrite(file.string(), image);
+  }
+  cv::Mat near_strokes;
+  cv::dilate(strokes, near_strokes, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  const auto points_on_display = [&](const fs::path& run, int frame) {
+    int count = 0;
+    for (const CsvPoint& p : ReadPointsCsv(run / "points.csv")) {
+      count += p.frame == frame && near_strokes.at<uint8_t>(cvRound(p.v), cvRound(p.u)) != 0;
+    }
+    return count;
+  };
+
+  const RunSummary left_out = RunSequence(folder / "sequence", TrackingExperiment(), folder / "left_out");
+  EXPECT_EQ(left_out.frames_tracked, 40);
+  EXPECT_GT(left_out.static_fraction, 0.02);
+  EXPECT_EQ(ReadJsonFile(folder / "left_out" / "summary.json").at("static_fraction"), left_out.static_fraction);
+  const cv::Mat static_mask = cv::imread((folder / "left_out" / "static_mask.png").string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(static_mask.empty());
+  EXPECT_EQ(cv::countNonZero(static_mask & strokes), cv::countNonZero(strokes));
+  for (int frame = 0; frame < 40; ++frame) EXPECT_EQ(points_on_display(folder / "left_out", frame), 0) << frame;
+  EXPECT_NE(DescribeSummary(left_out).find("never changed"), std::string::npos) << DescribeSummary(left_out);
+  EXPECT_LT(left_out.rmse_mm, 1.1 * summary_->rmse_mm) << "without the display: " << summary_->rmse_mm << " mm";
+
+  SystemOptions kept = TrackingExperiment();
+  kept.frontend.masks.static_frames = 0;
+  const RunSummary tracked = RunSequence(folder / "sequence", kept, folder / "tracked");
+  EXPECT_EQ(tracked.static_fraction, 0);
+  EXPECT_GE(points_on_display(folder / "tracked", 39), 5);
+  EXPECT_GT(tracked.rmse_mm, 1.1 * left_out.rmse_mm);
 }
 
 // An instrument over most of the view hides more than half of the map's tracks, but those it

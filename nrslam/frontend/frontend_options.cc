@@ -7,6 +7,11 @@ namespace nrslam {
 void MaskOptions::Check() const {
   CheckOption(border_px >= 0 && bright_margin_px >= 0 && erosion_px >= 0, "masks", "sizes must be >= 0");
   CheckOption(bright_threshold >= 0 && bright_threshold <= 255, "masks", "bright_threshold must be in [0, 255]");
+  CheckOption(static_frames == 0 || static_frames >= kMinStaticFrames, "masks",
+              "static_frames must be 0 (off) or >= " + std::to_string(kMinStaticFrames));
+  CheckOption(static_max_change >= 0 && static_max_change <= 255, "masks", "static_max_change must be in [0, 255]");
+  CheckOption(static_min_area_px >= 0 && static_margin_px >= 0, "masks", "static sizes must be >= 0");
+  CheckOption(static_min_edge >= 0, "masks", "static_min_edge must be >= 0");
 }
 
 void FeatureOptions::Check() const {

@@ -11,6 +11,16 @@ struct MaskOptions {
   int bright_threshold = 240;     // grey level above which a pixel is a specular highlight (255 = off)
   int bright_margin_px = 6;       // highlights also invalidate this many px around them
   int erosion_px = 5;             // the combined valid area is eroded by this, px
+  // Regions that never change over a run (an on-screen display, a black border without a
+  // mask): found once from this many frames spread over the run and left out, since a corner
+  // there would be tracked as a point that moves with the camera. 0 = off.
+  int static_frames = 24;
+  int static_max_change = 4;      // grey levels a static pixel may stray from its median, in 9 of 10 frames
+  int static_min_area_px = 64;    // smaller static patches are ignored (a few px of flat tissue)
+  double static_min_edge = 16;    // grey levels per px: a static patch without so strong an edge is flat tissue
+  int static_margin_px = 10;      // px around a static region left out too (about half the KLT window)
+  // The fewest frames that can tell a static region: one in ten may stray (a dropout, a flash).
+  static constexpr int kMinStaticFrames = 10;
   void Check() const;
 };
 
@@ -69,7 +79,9 @@ struct FrontendOptions {
   }
 };
 
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MaskOptions, border_px, bright_threshold, bright_margin_px, erosion_px)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MaskOptions, border_px, bright_threshold, bright_margin_px, erosion_px,
+                                                static_frames, static_max_change, static_min_area_px, static_min_edge,
+                                                static_margin_px)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureOptions, min_eigenvalue, nms_radius_px, exclusion_radius_px,
                                                 max_features)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(KltOptions, window_px, levels, max_iterations, epsilon_px,

@@ -37,6 +37,8 @@ class SequenceReader {
   cv::Mat ReadRight(int index) const;    // CV_8UC3
   // Validity mask for a frame: the fixed mask AND the frame's mask; empty if neither exists.
   cv::Mat ReadMask(int index) const;
+  // The sequence's fixed mask (mask.png); empty if it has none.
+  const cv::Mat& fixed_mask() const { return fixed_mask_; }
   const std::vector<StampedPose>& groundtruth() const { return groundtruth_; }
 
  private:

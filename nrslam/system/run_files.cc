@@ -45,6 +45,15 @@ std::string OcclusionText(int sudden_occlusions) {
          ": most of the view hidden at once, the tracks left matching well (the frames used; metrics.csv notes them)";
 }
 
+std::string StaticRegionText(double static_fraction) {
+  if (static_fraction <= 0) return "";
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << 100 * static_fraction
+       << " % of the image never changed (an on-screen display, a black border or background) and was left out"
+          " (static_mask.png)";
+  return text.str();
+}
+
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
   return stop_frame >= 0 ? "lost" : "ok";
@@ -90,6 +99,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (!dropouts.empty()) text << '\n' << dropouts;
   const std::string occlusions = OcclusionText(summary.sudden_occlusions);
   if (!occlusions.empty()) text << '\n' << occlusions;
+  const std::string still = StaticRegionText(summary.static_fraction);
+  if (!still.empty()) text << '\n' << still;
   return text.str();
 }
 
@@ -113,7 +124,7 @@ RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::fil
   // An earlier run's output in the same folder goes first, its summary before anything else: a
   // run that stops early must not leave the last run's result beside its own configuration,
   // nor a shorter run the longer run's depth maps.
-  for (const char* file : {"summary.json", "trajectory.tum", "map.ply", "run.log", "depth"}) {
+  for (const char* file : {"summary.json", "trajectory.tum", "map.ply", "run.log", "static_mask.png", "depth"}) {
     std::filesystem::remove_all(out / file, error);
     if (error) throw Error("cannot remove the earlier run's " + (out / file).string() + ": " + error.message());
   }
@@ -172,6 +183,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
                       {"frames_dropout", summary.frames_dropout},
                       {"sudden_occlusions", summary.sudden_occlusions},
+                      {"static_fraction", summary.static_fraction},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},
                       {"peak_memory_mb", summary.peak_memory_mb > 0 ? nlohmann::json(summary.peak_memory_mb) : nlohmann::json()},

@@ -45,6 +45,9 @@ struct RunSummary {
   // Frames tracked although most of the view was hidden at once (FrameResult::sudden_occlusion):
   // one per occlusion, not per frame it lasts.
   int sudden_occlusions = 0;
+  // The share of the image left out because it never changed over the run (an on-screen
+  // display, an unmasked black border; frontend FindStaticRegions, margin included).
+  double static_fraction = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)
   // The process's peak resident memory when the run ended (MB; util/memory_usage.h): the run's
   // own under nrslam_run and nrslam_eval, which give each sequence its own process. 0: not measured.
@@ -81,6 +84,10 @@ std::string DropoutText(int frames_dropout);
 // "2 sudden occlusions: most of the view hidden at once, the tracks left matching well (the
 // frames used; metrics.csv notes them)"; "" when none.
 std::string OcclusionText(int sudden_occlusions);
+
+// "9.9 % of the image never changed (an on-screen display, a black border or background) and was left out
+// (static_mask.png)"; "" when none.
+std::string StaticRegionText(double static_fraction);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <fstream>
@@ -11,12 +12,14 @@
 #include <utility>
 
 #include "nrslam/eval/depth_evaluation.h"
+#include "nrslam/frontend/masks.h"
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
 #include "nrslam/mapping/mapper.h"
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/tracking/tracker.h"
+#include "nrslam/util/concurrent.h"
 #include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/memory_usage.h"
@@ -56,12 +59,43 @@ struct FrameImages {
   std::string depth_problem;  // why depth_mm is empty although the sequence has depth
 };
 
+// The run's static regions (FindStaticRegions), from frames spread evenly over [first, last);
+// empty when the option is off, when fewer frames than that needs can be read (an unreadable
+// one is reported when the run reaches it), or when there are none.
+cv::Mat StaticRegionsOfRun(const SequenceReader& reader, int first, int last, const MaskOptions& options) {
+  if (options.static_frames == 0) return {};
+  const int span = last - first;
+  const int samples = std::min(options.static_frames, span);
+  if (samples < MaskOptions::kMinStaticFrames) return {};
+  // Decoding the frames takes most of the time: each core decodes every other one.
+  std::vector<cv::Mat> greys(static_cast<size_t>(samples));
+  const auto read_every_other = [&](int parity) {
+    for (int k = parity; k < samples; k += 2) {
+      const int frame = first + static_cast<int>(static_cast<int64_t>(k) * (span - 1) / (samples - 1));
+      try {
+        greys[static_cast<size_t>(k)] = ToGrey(reader.ReadRgb(frame));
+      } catch (const Error&) {
+      }
+    }
+  };
+  RunConcurrently([&] { read_every_other(0); }, [&] { read_every_other(1); });
+  const auto unread = [](const cv::Mat& grey) { return grey.empty(); };
+  greys.erase(std::remove_if(greys.begin(), greys.end(), unread), greys.end());
+  if (greys.size() < static_cast<size_t>(MaskOptions::kMinStaticFrames)) return {};
+  return FindStaticRegions(greys, reader.fixed_mask(), options);
+}
+
 // An unreadable colour image or mask makes the frame unusable (thrown); an unreadable depth map
-// only matters where depth is used, so it is reported beside the frame instead.
-FrameImages ReadFrame(const SequenceReader& reader, int frame) {
+// only matters where depth is used, so it is reported beside the frame instead. `static_regions`
+// (may be empty) are left out of the frame's mask.
+FrameImages ReadFrame(const SequenceReader& reader, int frame, const cv::Mat& static_regions) {
   FrameImages images;
   images.bgr = reader.ReadRgb(frame);
   images.mask = reader.ReadMask(frame);
+  if (!static_regions.empty()) {
+    if (images.mask.empty()) images.mask = cv::Mat(static_regions.size(), CV_8UC1, cv::Scalar(255));
+    images.mask.setTo(0, static_regions);
+  }
   if (reader.has_depth()) images.depth_mm = reader.TryReadDepthMm(frame, &images.depth_problem);
   return images;
 }
@@ -73,7 +107,8 @@ FrameImages ReadFrame(const SequenceReader& reader, int frame) {
 // only the wall-clock time changes.
 class FrameIo {
  public:
-  FrameIo(const SequenceReader& reader, int first, int last) : reader_(reader), next_(first), last_(last) {
+  FrameIo(const SequenceReader& reader, int first, int last, cv::Mat static_regions)
+      : reader_(reader), static_regions_(std::move(static_regions)), next_(first), last_(last) {
     Prefetch();
     Prefetch();
   }
@@ -110,9 +145,13 @@ class FrameIo {
 
  private:
   void Prefetch() {
-    if (next_ < last_) ahead_.push_back(std::async(std::launch::async, ReadFrame, std::cref(reader_), next_++).share());
+    if (next_ < last_) {
+      ahead_.push_back(
+          std::async(std::launch::async, ReadFrame, std::cref(reader_), next_++, std::cref(static_regions_)).share());
+    }
   }
   const SequenceReader& reader_;
+  const cv::Mat static_regions_;
   int next_;  // the next frame to prefetch
   int last_;
   // Futures of std::async wait for their thread when the last one sharing it goes, so a run
@@ -168,7 +207,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
-  FrameIo io(reader, first, last);
+  cv::Mat static_regions = StaticRegionsOfRun(reader, first, last, options.frontend.masks);
+  if (!static_regions.empty()) {
+    summary.static_fraction = cv::countNonZero(static_regions) / static_cast<double>(static_regions.total());
+    const fs::path file = out / "static_mask.png";
+    if (!cv::imwrite(file.string(), static_regions)) throw Error("cannot write " + file.string());
+    log << StaticRegionText(summary.static_fraction) << '\n';
+  }
+  FrameIo io(reader, first, last, std::move(static_regions));
   for (int frame = first; frame < last; ++frame) {
     FrameResult result;
     result.frame = frame;

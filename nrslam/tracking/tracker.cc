@@ -752,8 +752,8 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   if (search) {
     // A point the KLT lost where the mask now is was hidden, not lost to its own failure.
     for (PointId id : lost_now_) {
-      const auto lost = lost_.find(id);  // not if forgotten since
-      if (lost != lost_.end() && UnderMask(valid, lost->second.pixel)) lost->second.hidden = true;
+      const auto entry = lost_.find(id);  // not if forgotten since
+      if (entry != lost_.end() && UnderMask(valid, entry->second.pixel)) entry->second.hidden = true;
     }
     Reassociate(*pyramid, valid, &result);
   }
