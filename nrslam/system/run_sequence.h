@@ -8,8 +8,10 @@
 //   summary.json    rmse_mm, rmse_median_mm, rmse_pooled_mm, rmse_flat_mm, rmse_map_scale_mm,
 //                   rmse_median_scale_mm, frames_tracked, frames_total, init_frame, fps, peak_memory_mb,
 //                   ms per stage, maps, map_points, how far from the map's scale new points
-//                   were born (births_evaluated, birth_log_error_mean / _median) and the status
+//                   were born (births_evaluated, birth_log_error_mean / _median), the share of
+//                   the image left out as static (static_fraction) and the status
 //   map.ply         the final map points, coloured
+//   static_mask.png where the run found the image never changing and left it out (255), if anywhere
 //   run.log         what happened, in words
 #pragma once
 
