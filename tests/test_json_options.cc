@@ -141,6 +141,7 @@ TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_max_change=256"}), Error);
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_min_edge=-1"}), Error);
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_margin_px=-1"}), Error);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_max_fraction=1.5"}), Error);
 }
 
 TEST(JsonOptions, DropoutShareIsAFraction) {

@@ -1344,6 +1344,22 @@ TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   EXPECT_GT(tracked.rmse_mm, 1.1 * left_out.rmse_mm);
 }
 
+// A still camera over a still scene (every frame the first): all of it never changes, which is
+// a still view, not a display; leaving it all out would leave nothing to track.
+TEST_F(RunSequenceTest, AStillViewIsNotLeftOut) {
+  const fs::path folder = CopyOfSequence("still");
+  const fs::path sequence = folder / "sequence";
+  for (int frame = 1; frame < 40; ++frame) {
+    fs::copy_file(sequence / "rgb" / FrameFileName(0), sequence / "rgb" / FrameFileName(frame),
+                  fs::copy_options::overwrite_existing);
+  }
+  const RunSummary still = RunSequence(sequence, TrackingExperiment(), folder / "run");
+  EXPECT_EQ(still.static_fraction, 0);
+  EXPECT_FALSE(fs::exists(folder / "run" / "static_mask.png"));
+  EXPECT_EQ(still.frames_tracked, 40);
+  EXPECT_EQ(CountLines(folder / "run" / "run.log", "a still view rather than a display"), 1);
+}
+
 // An instrument over most of the view hides more than half of the map's tracks, but those it
 // leaves match as on an intact frame: the frames are tracked on the visible part, and the first
 // one's note says so. With every frame under the share taken for a dropout, they are skipped.

@@ -19,6 +19,9 @@ struct MaskOptions {
   int static_min_area_px = 64;    // smaller static patches are ignored (a few px of flat tissue)
   double static_min_edge = 16;    // grey levels per px: a static patch without so strong an edge is flat tissue
   int static_margin_px = 10;      // px around a static region left out too (about half the KLT window)
+  // More of the image than this static (margin included) is a still view, not a display:
+  // then nothing is left out.
+  double static_max_fraction = 0.8;
   // The fewest frames that can tell a static region: one in ten may stray (a dropout, a flash).
   static constexpr int kMinStaticFrames = 10;
   void Check() const;
@@ -81,7 +84,7 @@ struct FrontendOptions {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MaskOptions, border_px, bright_threshold, bright_margin_px, erosion_px,
                                                 static_frames, static_max_change, static_min_area_px, static_min_edge,
-                                                static_margin_px)
+                                                static_margin_px, static_max_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureOptions, min_eigenvalue, nms_radius_px, exclusion_radius_px,
                                                 max_features)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(KltOptions, window_px, levels, max_iterations, epsilon_px,

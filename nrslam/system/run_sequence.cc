@@ -208,8 +208,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
   cv::Mat static_regions = StaticRegionsOfRun(reader, first, last, options.frontend.masks);
-  if (!static_regions.empty()) {
-    summary.static_fraction = cv::countNonZero(static_regions) / static_cast<double>(static_regions.total());
+  const double static_fraction =
+      static_regions.empty() ? 0 : cv::countNonZero(static_regions) / static_cast<double>(static_regions.total());
+  if (static_fraction > options.frontend.masks.static_max_fraction) {
+    log << std::lround(100 * static_fraction)
+        << " % of the image never changed: a still view rather than a display, so none of it was left out\n";
+    static_regions.release();
+  } else if (static_fraction > 0) {
+    summary.static_fraction = static_fraction;
     const fs::path file = out / "static_mask.png";
     if (!cv::imwrite(file.string(), static_regions)) throw Error("cannot write " + file.string());
     log << StaticRegionText(summary.static_fraction) << '\n';
