@@ -22,6 +22,7 @@
 
 #include "camera_fixtures.h"
 #include "temp_folder.h"
+#include "nrslam/batch/report.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/deformation/deformation_graph.h"
@@ -1335,6 +1336,18 @@ TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   for (int frame = 0; frame < 40; ++frame) EXPECT_EQ(points_on_display(folder / "left_out", frame), 0) << frame;
   EXPECT_NE(DescribeSummary(left_out).find("never changed"), std::string::npos) << DescribeSummary(left_out);
   EXPECT_LT(left_out.rmse_mm, 1.1 * summary_->rmse_mm) << "without the display: " << summary_->rmse_mm << " mm";
+  // nrslam_eval's report shows it on the run's first frame.
+  RunResult result;
+  result.sequence = "display";
+  result.status = "ok";
+  result.static_fraction = left_out.static_fraction;
+  result.run_folder = (folder / "left_out").string();
+  WriteReport({result}, {}, {}, folder / "report");
+  std::ifstream page(folder / "report" / "index.html");
+  const std::string html((std::istreambuf_iterator<char>(page)), {});
+  EXPECT_NE(html.find("what the run left out as never changing"), std::string::npos);
+  EXPECT_NE(html.find("never changed (an on-screen display"), std::string::npos);
+  EXPECT_TRUE(fs::exists(folder / "report" / "display_static.png"));
 
   SystemOptions kept = TrackingExperiment();
   kept.frontend.masks.static_frames = 0;

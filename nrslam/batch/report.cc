@@ -1,5 +1,6 @@
 #include "nrslam/batch/report.h"
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
@@ -74,6 +75,22 @@ std::vector<PlotSeries> TopView(const std::filesystem::path& estimate_file, cons
   return plot;
 }
 
+// A frame of the run with what it left out as never changing (its static_mask.png) tinted red.
+std::string StaticRegionFigure(const SequenceReader& sequence, const std::filesystem::path& run, int frame,
+                               const std::filesystem::path& folder, const std::string& name) {
+  const cv::Mat left_out = cv::imread((run / "static_mask.png").string(), cv::IMREAD_GRAYSCALE);
+  cv::Mat image = sequence.ReadRgb(frame);
+  if (left_out.size() != image.size()) return "<p>static_mask.png is unreadable or not the images' size</p>\n";
+  cv::Mat tinted = image.clone();
+  tinted.setTo(cv::Scalar(0, 0, 255), left_out);
+  cv::addWeighted(image, 0.5, tinted, 0.5, 0, image);
+  if (!cv::imwrite((folder / name).string(), image)) throw Error("cannot write " + (folder / name).string());
+  std::ostringstream html;
+  html << "<div class=\"images\"><figure><img src=\"" << EscapeXml(name) << "\" width=\"640\"><figcaption>frame "
+       << frame << ": in red, what the run left out as never changing</figcaption></figure></div>\n";
+  return html.str();
+}
+
 // One run's section: plots and images, or why they are missing.
 std::string RunSection(const RunResult& result, const std::filesystem::path& folder) {
   std::ostringstream html;
@@ -132,6 +149,10 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
       html << LinePlotSvg(top, {title, "x (mm)", "z (mm)", 520, 300, true});
     }
     html << "</div>\n";
+    if (std::filesystem::exists(run / "static_mask.png") && !metrics.empty()) {
+      const int first_frame = static_cast<int>(Number(metrics.front(), "frame"));
+      html << StaticRegionFigure(sequence, run, first_frame, folder, Slug(result) + "_static.png");
+    }
     if (sequence.has_depth() && tracked.size() > 1) {
       // The first frame after initialisation, the middle one and the last tracked one.
       const std::set<int> shown = {tracked[1], tracked[tracked.size() / 2], tracked.back()};
