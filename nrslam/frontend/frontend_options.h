@@ -15,7 +15,7 @@ struct MaskOptions {
   // mask): found once from this many frames spread over the run and left out, since a corner
   // there would be tracked as a point that moves with the camera. 0 = off.
   int static_frames = 24;
-  int static_max_change = 4;      // grey levels a static pixel may stray from its median, in 9 of 10 frames
+  int static_max_change = 4;      // a static pixel is within this many grey levels of its median in 9 of 10 frames
   int static_min_area_px = 64;    // smaller static patches are ignored (a few px of flat tissue)
   double static_min_edge = 16;    // grey levels per px: a static patch without so strong an edge is flat tissue
   int static_margin_px = 10;      // px around a static region left out too (about half the KLT window)

@@ -23,8 +23,9 @@ cv::Mat BuildValidityMask(const cv::Mat& grey, const cv::Mat& sequence_mask, con
 // `static_margin_px` around; empty when there is none. A pixel is static when in 9 of 10
 // frames it is within `static_max_change` of its median, so that a dropout or a flash does not
 // hide an on-screen display. Static patches smaller than `static_min_area_px` (once the strokes
-// of text are joined) are flat tissue, not a display. Pixels `sequence_mask` (may be empty)
-// leaves out are not looked at: a masked black border is no news, nor should it grow a margin.
+// of text are joined), or without an edge of `static_min_edge` in the median frame, are still
+// tissue, not a display. Pixels `sequence_mask` (may be empty) leaves out are not looked at: a
+// masked black border is no news, nor should it grow a margin.
 cv::Mat FindStaticRegions(const std::vector<cv::Mat>& greys, const cv::Mat& sequence_mask, const MaskOptions& options);
 
 }  // namespace nrslam

@@ -85,8 +85,8 @@ std::string DropoutText(int frames_dropout);
 // frames used; metrics.csv notes them)"; "" when none.
 std::string OcclusionText(int sudden_occlusions);
 
-// "9.9 % of the image never changed (an on-screen display, a black border or background) and was left out
-// (static_mask.png)"; "" when none.
+// "9.9 % of the image never changed (an on-screen display, a black border or background) and
+// was left out (static_mask.png)"; "" when none.
 std::string StaticRegionText(double static_fraction);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
