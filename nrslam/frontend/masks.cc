@@ -97,12 +97,13 @@ cv::Mat FindStaticRegions(const std::vector<cv::Mat>& greys, const cv::Mat& sequ
   bool any = false;
   for (int patch = 1; patch < patches; ++patch) {
     if (stats.at<int>(patch, cv::CC_STAT_AREA) < options.static_min_area_px) continue;
+    const cv::Mat in_patch = labels == patch;
     cv::Mat around;
-    cv::dilate(labels == patch, around, cv::Mat());
+    cv::dilate(in_patch, around, cv::Mat());
     double strongest = 0;
     cv::minMaxLoc(edges, nullptr, &strongest, nullptr, nullptr, around);
     if (strongest < options.static_min_edge) continue;
-    regions.setTo(255, labels == patch);
+    regions.setTo(255, in_patch);
     any = true;
   }
   if (!any) return {};
