@@ -206,13 +206,10 @@ std::string StopText(const RunResult& result) {
 }
 
 std::vector<std::string> RunNotes(const RunResult& result) {
-  std::vector<std::string> notes;
-  for (std::string note : {StopText(result), UnreadableInputText(result.frames_unreadable,
-                                                                 result.frames_groundtruth_unreadable),
-                           DropoutText(result.frames_dropout), OcclusionText(result.sudden_occlusions),
-                           StaticRegionText(result.static_fraction)}) {
-    if (!note.empty()) notes.push_back(std::move(note));
-  }
+  std::vector<std::string> notes = InputNotes(result.frames_unreadable, result.frames_groundtruth_unreadable,
+                                              result.frames_dropout, result.sudden_occlusions, result.static_fraction);
+  const std::string stop = StopText(result);
+  if (!stop.empty()) notes.insert(notes.begin(), stop);
   return notes;
 }
 

@@ -64,11 +64,13 @@ cv::Mat FindStaticRegions(const std::vector<cv::Mat>& greys, const cv::Mat& sequ
   const size_t allowed_strays = frames / 10;
   cv::Mat still(size, CV_8UC1, cv::Scalar(0)), median(size, CV_8UC1);
   std::vector<uint8_t> values(frames);
+  std::vector<const uint8_t*> rows(frames);
   for (int row = 0; row < size.height; ++row) {
+    for (size_t k = 0; k < frames; ++k) rows[k] = greys[k].ptr<uint8_t>(row);
     uint8_t* out = still.ptr<uint8_t>(row);
     uint8_t* middle = median.ptr<uint8_t>(row);
     for (int col = 0; col < size.width; ++col) {
-      for (size_t k = 0; k < frames; ++k) values[k] = greys[k].ptr<uint8_t>(row)[col];
+      for (size_t k = 0; k < frames; ++k) values[k] = rows[k][col];
       std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(frames / 2), values.end());
       middle[col] = values[frames / 2];
       const auto strays = static_cast<size_t>(std::count_if(values.begin(), values.end(), [&](uint8_t value) {

@@ -54,6 +54,17 @@ std::string StaticRegionText(double static_fraction) {
   return text.str();
 }
 
+std::vector<std::string> InputNotes(int frames_unreadable, int frames_groundtruth_unreadable, int frames_dropout,
+                                    int sudden_occlusions, double static_fraction) {
+  std::vector<std::string> notes;
+  for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
+                           DropoutText(frames_dropout), OcclusionText(sudden_occlusions),
+                           StaticRegionText(static_fraction)}) {
+    if (!note.empty()) notes.push_back(std::move(note));
+  }
+  return notes;
+}
+
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
   return stop_frame >= 0 ? "lost" : "ok";
@@ -93,14 +104,11 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
-  const std::string unreadable = UnreadableInputText(summary.frames_unreadable, summary.frames_groundtruth_unreadable);
-  if (!unreadable.empty()) text << '\n' << unreadable;
-  const std::string dropouts = DropoutText(summary.frames_dropout);
-  if (!dropouts.empty()) text << '\n' << dropouts;
-  const std::string occlusions = OcclusionText(summary.sudden_occlusions);
-  if (!occlusions.empty()) text << '\n' << occlusions;
-  const std::string still = StaticRegionText(summary.static_fraction);
-  if (!still.empty()) text << '\n' << still;
+  for (const std::string& note : InputNotes(summary.frames_unreadable, summary.frames_groundtruth_unreadable,
+                                            summary.frames_dropout, summary.sudden_occlusions,
+                                            summary.static_fraction)) {
+    text << '\n' << note;
+  }
   return text.str();
 }
 

@@ -89,6 +89,11 @@ std::string OcclusionText(int sudden_occlusions);
 // was left out (static_mask.png)"; "" when none.
 std::string StaticRegionText(double static_fraction);
 
+// What the input did to a run, one note each, those that apply, in the order the runner and
+// nrslam_eval print them: unreadable files, image dropouts, sudden occlusions, static regions.
+std::vector<std::string> InputNotes(int frames_unreadable, int frames_groundtruth_unreadable, int frames_dropout,
+                                    int sudden_occlusions, double static_fraction);
+
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked
 // camera centres (one segment per map).
