@@ -449,6 +449,17 @@ TEST(OpenCvModel, CalibrationFilesAreReadAsOpenCvAndRosWriteThem) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(CameraModels, KannalaBrandtUnprojectsPastWhereNewtonFails) {
+  // Strong coefficients (r(θ) folds back at 0.775 rad): Newton from the undistorted angle lands
+  // beyond the fold at the image's edge; the ray found instead must project back to the pixel.
+  const Camera squeezed = Camera::KannalaBrandt(320, 240, 160, 160, 159.5, 119.5, Eigen::Vector4d(1e9, -1e9, 3, 4));
+  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, 119.5), Eigen::Vector2d(319, 0), Eigen::Vector2d(200, 119.5)}) {
+    const std::optional<Eigen::Vector2d> back = squeezed.Project(squeezed.Unproject(pixel));
+    ASSERT_TRUE(back.has_value()) << pixel.transpose();
+    EXPECT_LT((*back - pixel).norm(), 1e-6) << pixel.transpose();
+  }
+}
+
 TEST(CameraCheck, RejectsWrongCalibrations) {
   auto message = [](const Camera& camera) {
     try {
@@ -469,6 +480,14 @@ TEST(CameraCheck, RejectsWrongCalibrations) {
   EXPECT_EQ(message(Camera::Pinhole(720, 288, 800, 400, 360, 144)), "");  // an interlaced field
   EXPECT_NE(message(Camera::KannalaBrandt(640, 480, 300, 300, 320, 240, Eigen::Vector4d(-5, 0, 0, 0))).find("fold"),
             std::string::npos);
+  // Coefficients that pass the fold-back test but squeeze the image into a hundredth of a degree.
+  EXPECT_NE(message(Camera::KannalaBrandt(320, 240, 160, 160, 159.5, 119.5, Eigen::Vector4d(1e9, -1e9, 3, 4)))
+                .find("degrees of view"),
+            std::string::npos);
+  EXPECT_NE(message(Camera::OpenCv(320, 240, 160, 160, 159.5, 119.5, {1e8, 0, 0, 0})).find("degrees of view"),
+            std::string::npos);
+  EXPECT_EQ(message(Camera::OpenCv(320, 240, 160, 160, 159.5, 119.5, {50, 100, 0, 0, 200})), "")
+      << "a 15-degree view is narrow, not wrong";
   EXPECT_EQ(message(Pinhole()), "");
   EXPECT_THROW((nlohmann::json{{"model", "orthographic"}, {"width", 1}, {"height", 1}, {"fx", 1}, {"fy", 1},
                                 {"cx", 0}, {"cy", 0}}.get<Camera>()),

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <iterator>
 #include <limits>
 #include <utility>
@@ -230,13 +231,29 @@ Eigen::Vector3d Camera::Unproject(const Eigen::Vector2d& pixel) const {
   const double mx = (pixel.x() - cx()) / fx(), my = (pixel.y() - cy()) / fy();
   const double radius = std::hypot(mx, my);
   if (model_ == CameraModelId::kKannalaBrandt) {
-    if (radius <= KannalaBrandtModel::Distort(params_.data(), max_theta_)) return bearing;
+    if (radius <= KannalaBrandtModel::Distort(params_.data(), max_theta_)) return KannalaBrandtRay(mx, my, bearing);
   } else {
     // The tangential terms move the reach off a circle: trust Newton's ray if it lands on the pixel.
     const std::optional<Eigen::Vector2d> back = Project(bearing);
     if (back && (*back - pixel).norm() < 1e-6) return bearing;
   }
   return Eigen::Vector3d(std::sin(max_theta_) * mx / radius, std::sin(max_theta_) * my / radius, std::cos(max_theta_));
+}
+
+Eigen::Vector3d Camera::KannalaBrandtRay(double mx, double my, const Eigen::Vector3d& newton_ray) const {
+  // Strong coefficients can send Newton past the fold of r(θ); r grows on [0, max_theta], so
+  // bisect there instead.
+  const double radius = std::hypot(mx, my);
+  const auto misfit = [&](double theta) { return KannalaBrandtModel::Distort(params_.data(), theta) - radius; };
+  const double newton_theta = std::atan2(newton_ray.head<2>().norm(), newton_ray.z());
+  if (newton_theta <= max_theta_ && std::abs(misfit(newton_theta)) <= 1e-9 * std::max(1.0, radius)) return newton_ray;
+  double low = 0.0, high = max_theta_;
+  for (int halving = 0; halving < 60; ++halving) {
+    const double middle = 0.5 * (low + high);
+    (misfit(middle) < 0 ? low : high) = middle;
+  }
+  const double theta = 0.5 * (low + high);
+  return Eigen::Vector3d(std::sin(theta) * mx / radius, std::sin(theta) * my / radius, std::cos(theta));
 }
 
 Eigen::Matrix<double, 2, 3> Camera::ProjectionJacobian(const Eigen::Vector3d& point) const {
@@ -297,6 +314,25 @@ void Camera::Check() const {
   }
   if (model_ == CameraModelId::kOcam) CheckOcam();
   if (model_ == CameraModelId::kOpenCv) CheckOpenCv();
+  CheckFieldOfView();
+}
+
+void Camera::CheckFieldOfView() const {
+  // The focal-length bound above, for what the distortion does: lens coefficients that squeeze
+  // the whole image into a sliver of a degree are wrong, or belong to another unit.
+  constexpr double kMinViewDeg = 1.0;
+  const auto angle = [&](double u0, double v0, double u1, double v1) {
+    const Eigen::Vector3d a = Unproject({u0, v0}), b = Unproject({u1, v1});
+    return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+  };
+  const double across = angle(0, cy(), width_ - 1, cy()), down = angle(cx(), 0, cx(), height_ - 1);
+  if (!(std::min(across, down) >= kMinViewDeg)) {
+    std::ostringstream text;
+    text << std::setprecision(3) << "camera: " << model_name() << ": the image spans " << across << " x " << down
+         << " degrees of view (under " << kMinViewDeg
+         << "): lens coefficients that are wrong, or of another unit or image size?";
+    throw Error(text.str());
+  }
 }
 
 void Camera::CheckOpenCv() const {

@@ -76,6 +76,9 @@ class Camera {
   void ComputeMaxTheta();
   void CheckOcam() const;
   void CheckOpenCv() const;
+  void CheckFieldOfView() const;
+  // The ray of a pixel at normalised offset (mx, my) inside the Kannala–Brandt image circle.
+  Eigen::Vector3d KannalaBrandtRay(double mx, double my, const Eigen::Vector3d& newton_ray) const;
 };
 
 void to_json(nlohmann::json& j, const Camera& camera);
