@@ -132,7 +132,8 @@ TEST(JsonOptions, ReassociationConsensusIsACount) {
 }
 
 TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
-  const FrontendOptions off = WithAssignments(FrontendOptions{}, {"masks.static_frames=0", "masks.static_min_edge=8"});
+  const FrontendOptions off =
+      WithAssignments(FrontendOptions{}, {"masks.static_frames=0", "masks.static_min_edge=8", "masks.static_min_seconds=1.5"});
   EXPECT_EQ(Json(OptionsFromJson<FrontendOptions>(Json(off), "test")), Json(off));
   EXPECT_EQ(off.masks.static_frames, 0);
   EXPECT_EQ(FrontendOptions{}.masks.static_frames, 24);
@@ -142,6 +143,8 @@ TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_min_edge=-1"}), Error);
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_margin_px=-1"}), Error);
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_max_fraction=1.5"}), Error);
+  EXPECT_EQ(off.masks.static_min_seconds, 1.5);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_min_seconds=-1"}), Error);
 }
 
 TEST(JsonOptions, DropoutShareIsAFraction) {

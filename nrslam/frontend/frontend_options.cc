@@ -12,6 +12,7 @@ void MaskOptions::Check() const {
   CheckOption(static_max_change >= 0 && static_max_change <= 255, "masks", "static_max_change must be in [0, 255]");
   CheckOption(static_min_area_px >= 0 && static_margin_px >= 0, "masks", "static sizes must be >= 0");
   CheckOption(static_min_edge >= 0, "masks", "static_min_edge must be >= 0");
+  CheckOption(static_min_seconds >= 0, "masks", "static_min_seconds must be >= 0");
   CheckOption(static_max_fraction >= 0 && static_max_fraction <= 1, "masks", "static_max_fraction must be in [0, 1]");
 }
 

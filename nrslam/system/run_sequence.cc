@@ -60,11 +60,21 @@ struct FrameImages {
 };
 
 // The run's static regions (FindStaticRegions), from frames spread evenly over [first, last);
-// empty when the option is off, when fewer frames than that needs can be read (an unreadable
-// one is reported when the run reaches it), or when there are none.
-cv::Mat StaticRegionsOfRun(const SequenceReader& reader, int first, int last, const MaskOptions& options) {
+// empty when the option is off, when the run is too short to tell (said in `log`), when fewer
+// frames than that needs can be read (an unreadable one is reported when the run reaches it), or
+// when there are none.
+cv::Mat StaticRegionsOfRun(const SequenceReader& reader, int first, int last, const MaskOptions& options,
+                           std::ostream& log) {
   if (options.static_frames == 0) return {};
   const int span = last - first;
+  const double seconds = (span - 1) / reader.info().fps;
+  if (seconds < options.static_min_seconds) {
+    std::ostringstream note;
+    note << std::fixed << std::setprecision(1) << "not looked for regions that never change (an on-screen display): "
+         << "the run spans " << seconds << " s, under static_min_seconds = " << options.static_min_seconds << " s\n";
+    log << note.str();
+    return {};
+  }
   const int samples = std::min(options.static_frames, span);
   if (samples < MaskOptions::kMinStaticFrames) return {};
   // Decoding the frames takes most of the time: each core decodes every other one.
@@ -207,7 +217,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
-  cv::Mat static_regions = StaticRegionsOfRun(reader, first, last, options.frontend.masks);
+  cv::Mat static_regions = StaticRegionsOfRun(reader, first, last, options.frontend.masks, log);
   const double static_fraction =
       static_regions.empty() ? 0 : cv::countNonZero(static_regions) / static_cast<double>(static_regions.total());
   if (static_fraction > options.frontend.masks.static_max_fraction) {
