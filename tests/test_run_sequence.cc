@@ -152,7 +152,7 @@ TEST_F(RunSequenceTest, TracksEveryFrameAndBeatsAFrozenMapByFar) {
   // 40 frames are 1.3 s: too short to tell a display from tissue the camera has barely moved past.
   EXPECT_EQ(summary_->static_fraction, 0);
   EXPECT_FALSE(fs::exists(*base_ / "run" / "static_mask.png"));
-  EXPECT_EQ(CountLines(*base_ / "run" / "run.log", "the run spans 1.3 s, under static_min_seconds = 4.0 s"), 1);
+  EXPECT_EQ(CountLines(*base_ / "run" / "run.log", "the run spans 1.3 s, under static_min_seconds = 3.5 s"), 1);
   // What a tracker that never moved would score: every tracked point at its initial depth.
   const SequenceReader reader(*base_ / "sequence");
   const std::vector<CsvPoint> points = ReadPointsCsv(*base_ / "run" / "points.csv");

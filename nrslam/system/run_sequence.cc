@@ -67,7 +67,7 @@ cv::Mat StaticRegionsOfRun(const SequenceReader& reader, int first, int last, co
                            std::ostream& log) {
   if (options.static_frames == 0) return {};
   const int span = last - first;
-  const double seconds = (span - 1) / reader.info().fps;
+  const double seconds = span / reader.info().fps;
   if (seconds < options.static_min_seconds) {
     std::ostringstream note;
     note << std::fixed << std::setprecision(1) << "not looked for regions that never change (an on-screen display): "
