@@ -152,7 +152,7 @@ TEST_F(RunSequenceTest, TracksEveryFrameAndBeatsAFrozenMapByFar) {
   // 40 frames are 1.3 s: too short to tell a display from tissue the camera has barely moved past.
   EXPECT_EQ(summary_->static_fraction, 0);
   EXPECT_FALSE(fs::exists(*base_ / "run" / "static_mask.png"));
-  EXPECT_EQ(CountLines(*base_ / "run" / "run.log", "the run spans 1.3 s, under static_min_seconds = 3.5 s"), 1);
+  EXPECT_EQ(CountLines(*base_ / "run" / "run.log", "the sequence spans 1.3 s, under static_min_seconds = 3.5 s"), 1);
   // What a tracker that never moved would score: every tracked point at its initial depth.
   const SequenceReader reader(*base_ / "sequence");
   const std::vector<CsvPoint> points = ReadPointsCsv(*base_ / "run" / "points.csv");
@@ -1308,17 +1308,23 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
 // every frame: corners on it would be tracked as points that move with the camera. The run finds
 // it static from 24 of its frames and leaves it out; with that off, the display is tracked. (The
 // fixture's 1.3 s are let pass for a long enough run; on this sequence nothing else stays put.)
-TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
-  const fs::path folder = CopyOfSequence("display");
+// Paints the display's two lines of grey text on every frame of `sequence`; returns the strokes.
+cv::Mat PaintDisplay(const fs::path& sequence) {
   cv::Mat strokes(240, 320, CV_8UC1, cv::Scalar(0));
   cv::putText(strokes, "CV-190  ID 0042", {20, 40}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
   cv::putText(strokes, "Eh:A3 Cm:1", {20, 205}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
   for (int frame = 0; frame < 40; ++frame) {
-    const fs::path file = folder / "sequence" / "rgb" / FrameFileName(frame);
+    const fs::path file = sequence / "rgb" / FrameFileName(frame);
     cv::Mat image = cv::imread(file.string());
     image.setTo(cv::Scalar(150, 225, 150), strokes);
     cv::imwrite(file.string(), image);
   }
+  return strokes;
+}
+
+TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
+  const fs::path folder = CopyOfSequence("display");
+  const cv::Mat strokes = PaintDisplay(folder / "sequence");
   cv::Mat near_strokes;
   cv::dilate(strokes, near_strokes, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
   const auto points_on_display = [&](const fs::path& run, int frame) {
@@ -1380,17 +1386,36 @@ TEST_F(RunSequenceTest, AStillViewIsNotLeftOut) {
   EXPECT_EQ(CountLines(folder / "run" / "run.log", "a still view rather than a display"), 1);
 }
 
-// Over a short run the tissue near the lumen's far end barely changes: 12 frames of sim-2 at
-// 160x120 left two thirds of the image out as never changing, and tracking then lost the map.
-// Such a run is not checked.
-TEST(RunSequenceShortRun, IsNotCheckedForDisplays) {
+// A run of a few frames is checked over its whole sequence: the display is found from all 40
+// frames (4 s at 10 fps), and the run of the first 12 leaves it out.
+TEST_F(RunSequenceTest, AShortRunIsCheckedForADisplayOverItsWholeSequence) {
+  const fs::path folder = CopyOfSequence("display_short_run");
+  const fs::path sequence = folder / "sequence";
+  const cv::Mat strokes = PaintDisplay(sequence);
+  nlohmann::json info = ReadJsonFile(sequence / "sequence.json");
+  info["fps"] = 10.0;
+  std::ofstream(sequence / "sequence.json") << info.dump(2);
+  SystemOptions first_frames = TrackingExperiment();
+  first_frames.run.last_frame = 12;
+  const RunSummary run = RunSequence(sequence, first_frames, folder / "run");
+  EXPECT_EQ(run.frames_total, 12);
+  EXPECT_GT(run.static_fraction, 0.02);
+  const cv::Mat static_mask = cv::imread((folder / "run" / "static_mask.png").string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(static_mask.empty());
+  EXPECT_EQ(cv::countNonZero(static_mask & strokes), cv::countNonZero(strokes));
+}
+
+// Over a short sequence the tissue near the lumen's far end barely changes: 12 frames of sim-2
+// at 160x120 left two thirds of the image out as never changing, and tracking then lost the map.
+// Such a sequence is not checked.
+TEST(RunSequenceShortSequence, IsNotCheckedForDisplays) {
   const fs::path folder = UniqueTempFolder("nrslam_short_run_test");
   fs::remove_all(folder);
   SimulateSmall("sim-2", 12, 160, 120, folder / "sequence");
   const RunSummary short_run = RunSequence(folder / "sequence", TrackingExperiment(), folder / "run");
   EXPECT_EQ(short_run.static_fraction, 0);
   EXPECT_EQ(short_run.frames_tracked, 12);
-  EXPECT_EQ(CountLines(folder / "run" / "run.log", "the run spans 0.4 s, under static_min_seconds"), 1);
+  EXPECT_EQ(CountLines(folder / "run" / "run.log", "the sequence spans 0.4 s, under static_min_seconds"), 1);
   SystemOptions unguarded = TrackingExperiment();
   unguarded.frontend.masks.static_min_seconds = 0;
   const RunSummary checked = RunSequence(folder / "sequence", unguarded, folder / "checked");

@@ -11,9 +11,9 @@ struct MaskOptions {
   int bright_threshold = 240;     // grey level above which a pixel is a specular highlight (255 = off)
   int bright_margin_px = 6;       // highlights also invalidate this many px around them
   int erosion_px = 5;             // the combined valid area is eroded by this, px
-  // Regions that never change over a run (an on-screen display, a black border without a
-  // mask): found once from this many frames spread over the run and left out, since a corner
-  // there would be tracked as a point that moves with the camera. 0 = off.
+  // Regions that never change over a sequence (an on-screen display, a black border without a
+  // mask): found once from this many frames spread over the sequence and left out, since a
+  // corner there would be tracked as a point that moves with the camera. 0 = off.
   int static_frames = 24;
   int static_max_change = 4;      // a static pixel is within this many grey levels of its median in 9 of 10 frames
   int static_min_area_px = 64;    // smaller static patches are ignored (a few px of flat tissue)
@@ -22,7 +22,7 @@ struct MaskOptions {
   // More of the image than this static (margin included) is a still view, not a display:
   // then nothing is left out.
   double static_max_fraction = 0.8;
-  // s: a run spanning less is not checked. Over a short span tissue the camera barely moves
+  // s: a sequence spanning less is not checked. Over a short span tissue the camera barely moves
   // past stays put as a display does (intact renderings at 80x60 to 640x480 lost up to 84 % of
   // the image to the check within 2.5 s, none from 3 s on).
   double static_min_seconds = 3.5;

@@ -59,19 +59,19 @@ struct FrameImages {
   std::string depth_problem;  // why depth_mm is empty although the sequence has depth
 };
 
-// The run's static regions (FindStaticRegions), from frames spread evenly over [first, last);
-// empty when the option is off, when the run is too short to tell (said in `log`), when fewer
-// frames than that needs can be read (an unreadable one is reported when the run reaches it), or
-// when there are none.
-cv::Mat StaticRegionsOfRun(const SequenceReader& reader, int first, int last, const MaskOptions& options,
-                           std::ostream& log) {
+// The sequence's static regions (FindStaticRegions), from frames spread evenly over all of it,
+// whatever part a run takes: the longer the span, the surer the verdict. Empty when the option is
+// off, when the sequence is too short to tell (said in `log`), when fewer frames than that needs
+// can be read (an unreadable one is reported when a run reaches it), or when there are none.
+cv::Mat StaticRegionsOfSequence(const SequenceReader& reader, const MaskOptions& options, std::ostream& log) {
   if (options.static_frames == 0) return {};
-  const int span = last - first;
+  const int span = reader.frame_count();
   const double seconds = span / reader.info().fps;
   if (seconds < options.static_min_seconds) {
     std::ostringstream note;
     note << std::fixed << std::setprecision(1) << "not looked for regions that never change (an on-screen display): "
-         << "the run spans " << seconds << " s, under static_min_seconds = " << options.static_min_seconds << " s\n";
+         << "the sequence spans " << seconds << " s, under static_min_seconds = " << options.static_min_seconds
+         << " s\n";
     log << note.str();
     return {};
   }
@@ -81,7 +81,7 @@ cv::Mat StaticRegionsOfRun(const SequenceReader& reader, int first, int last, co
   std::vector<cv::Mat> greys(static_cast<size_t>(samples));
   const auto read_every_other = [&](int parity) {
     for (int k = parity; k < samples; k += 2) {
-      const int frame = first + static_cast<int>(static_cast<int64_t>(k) * (span - 1) / (samples - 1));
+      const int frame = static_cast<int>(static_cast<int64_t>(k) * (span - 1) / (samples - 1));
       try {
         greys[static_cast<size_t>(k)] = ToGrey(reader.ReadRgb(frame));
       } catch (const Error&) {
@@ -217,7 +217,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
-  cv::Mat static_regions = StaticRegionsOfRun(reader, first, last, options.frontend.masks, log);
+  cv::Mat static_regions = StaticRegionsOfSequence(reader, options.frontend.masks, log);
   const double static_fraction =
       static_regions.empty() ? 0 : cv::countNonZero(static_regions) / static_cast<double>(static_regions.total());
   if (static_fraction > options.frontend.masks.static_max_fraction) {
