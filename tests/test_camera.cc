@@ -453,7 +453,8 @@ TEST(CameraModels, KannalaBrandtUnprojectsPastWhereNewtonFails) {
   // Strong coefficients (r(θ) folds back at 0.775 rad): Newton from the undistorted angle lands
   // beyond the fold at the image's edge; the ray found instead must project back to the pixel.
   const Camera squeezed = Camera::KannalaBrandt(320, 240, 160, 160, 159.5, 119.5, Eigen::Vector4d(1e9, -1e9, 3, 4));
-  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, 119.5), Eigen::Vector2d(319, 0), Eigen::Vector2d(200, 119.5)}) {
+  for (const Eigen::Vector2d& pixel :
+       {Eigen::Vector2d(0, 119.5), Eigen::Vector2d(319, 0), Eigen::Vector2d(200, 119.5)}) {
     const std::optional<Eigen::Vector2d> back = squeezed.Project(squeezed.Unproject(pixel));
     ASSERT_TRUE(back.has_value()) << pixel.transpose();
     EXPECT_LT((*back - pixel).norm(), 1e-6) << pixel.transpose();

@@ -133,7 +133,8 @@ TEST(JsonOptions, ReassociationConsensusIsACount) {
 
 TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
   const FrontendOptions off =
-      WithAssignments(FrontendOptions{}, {"masks.static_frames=0", "masks.static_min_edge=8", "masks.static_min_seconds=1.5"});
+      WithAssignments(FrontendOptions{}, {"masks.static_frames=0", "masks.static_min_edge=8",
+                                          "masks.static_min_seconds=1.5"});
   EXPECT_EQ(Json(OptionsFromJson<FrontendOptions>(Json(off), "test")), Json(off));
   EXPECT_EQ(off.masks.static_frames, 0);
   EXPECT_EQ(FrontendOptions{}.masks.static_frames, 24);

@@ -67,7 +67,6 @@ std::vector<CsvPoint> ReadPointsCsv(const fs::path& path) {
   return points;
 }
 
-// The paper's tracking experiment: the map from the first frame's depth, no mapping.
 int CountLines(const fs::path& file, const std::string& text) {
   std::ifstream in(file);
   int count = 0;
@@ -75,6 +74,7 @@ int CountLines(const fs::path& file, const std::string& text) {
   return count;
 }
 
+// The paper's tracking experiment: the map from the first frame's depth, no mapping.
 SystemOptions TrackingExperiment() {
   SystemOptions options;
   options.run.init = "depth";
@@ -1304,11 +1304,8 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
   ExpectLostFromFrame(folder, count_only, 15);
 }
 
-// An endoscope's on-screen display (grey text, not bright enough to pass for a highlight) on
-// every frame: corners on it would be tracked as points that move with the camera. The run finds
-// it static from 24 of its frames and leaves it out; with that off, the display is tracked. (The
-// fixture's 1.3 s are let pass for a long enough run; on this sequence nothing else stays put.)
-// Paints the display's two lines of grey text on every frame of `sequence`; returns the strokes.
+// Paints an on-screen display's two lines of grey text on every frame of `sequence`; returns
+// the strokes.
 cv::Mat PaintDisplay(const fs::path& sequence) {
   cv::Mat strokes(240, 320, CV_8UC1, cv::Scalar(0));
   cv::putText(strokes, "CV-190  ID 0042", {20, 40}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
@@ -1322,6 +1319,10 @@ cv::Mat PaintDisplay(const fs::path& sequence) {
   return strokes;
 }
 
+// An endoscope's on-screen display (grey text, not bright enough to pass for a highlight) on
+// every frame: corners on it would be tracked as points that move with the camera. The run finds
+// it static from 24 of its frames and leaves it out; with that off, the display is tracked. (The
+// fixture's 1.3 s are let pass for a long enough sequence; on it nothing else stays put.)
 TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   const fs::path folder = CopyOfSequence("display");
   const cv::Mat strokes = PaintDisplay(folder / "sequence");

@@ -23,8 +23,8 @@ struct MaskOptions {
   // then nothing is left out.
   double static_max_fraction = 0.8;
   // s: a sequence spanning less is not checked. Over a short span tissue the camera barely moves
-  // past stays put as a display does (intact renderings at 80x60 to 640x480 lost up to 84 % of
-  // the image to the check within 2.5 s, none from 3 s on).
+  // past stays put as a display does (intact renderings at 160x120 to 640x480 lost up to 84 %
+  // of the image to the check within 2.5 s, none from 3 s on).
   double static_min_seconds = 3.5;
   // The fewest frames that can tell a static region: one in ten may stray (a dropout, a flash).
   static constexpr int kMinStaticFrames = 10;
