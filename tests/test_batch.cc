@@ -572,6 +572,7 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   damaged.frames_groundtruth_unreadable = 2;
   damaged.frames_dropout = 3;
   damaged.sudden_occlusions = 2;
+  damaged.view_jumps = 1;
   damaged.static_fraction = 0.125;
   const RunResult fine = Result("sim-0", 0.1, 60);
   std::stringstream table;
@@ -584,12 +585,15 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
       << table.str();
   EXPECT_NE(table.str().find("sim-2: 2 sudden occlusions: most of the view hidden at once"), std::string::npos)
       << table.str();
+  EXPECT_NE(table.str().find("sim-2: 1 jump of the view: its tracks moved far more than over the frames before"),
+            std::string::npos)
+      << table.str();
   EXPECT_NE(table.str().find("sim-2: 12.5 % of the image never changed (an on-screen display, a black border or "
                              "background) and was left out (static_mask.png)"),
             std::string::npos)
       << table.str();
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
-  EXPECT_EQ(RunNotes(damaged).size(), 4u);
+  EXPECT_EQ(RunNotes(damaged).size(), 5u);
   EXPECT_TRUE(RunNotes(fine).empty());
   // The report's section of the run says the same.
   const auto folder = UniqueTempFolder("results_notes_report");
@@ -608,6 +612,8 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_EQ(read[1].frames_dropout, 0);
   EXPECT_EQ(read[0].sudden_occlusions, 2);
   EXPECT_EQ(read[1].sudden_occlusions, 0);
+  EXPECT_EQ(read[0].view_jumps, 1);
+  EXPECT_EQ(read[1].view_jumps, 0);
   EXPECT_EQ(read[0].static_fraction, 0.125);
   EXPECT_EQ(read[1].static_fraction, 0);
 }

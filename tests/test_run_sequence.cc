@@ -153,6 +153,7 @@ TEST_F(RunSequenceTest, TracksEveryFrameAndBeatsAFrozenMapByFar) {
   EXPECT_EQ(summary_->static_fraction, 0);
   EXPECT_FALSE(fs::exists(*base_ / "run" / "static_mask.png"));
   EXPECT_EQ(CountLines(*base_ / "run" / "run.log", "the sequence spans 1.3 s, under static_min_seconds = 3.5 s"), 1);
+  EXPECT_EQ(summary_->view_jumps, 0);
   // What a tracker that never moved would score: every tracked point at its initial depth.
   const SequenceReader reader(*base_ / "sequence");
   const std::vector<CsvPoint> points = ReadPointsCsv(*base_ / "run" / "points.csv");
@@ -1423,6 +1424,39 @@ TEST(RunSequenceShortSequence, IsNotCheckedForDisplays) {
   EXPECT_GT(checked.static_fraction, 0.3) << "the check would mistake this tissue for a display";
   EXPECT_LT(checked.frames_tracked, 12);
   fs::remove_all(folder);
+}
+
+// Frames 15–22 cut out of the recording: the tissue moves as far at once as over 9 frames. The
+// frame after the cut is tracked and noted as a jump of the view, and no other is.
+TEST_F(RunSequenceTest, FramesMissingFromTheRecordingAreNotedAsAJump) {
+  const fs::path folder = CopyOfSequence("cut");
+  const fs::path sequence = folder / "sequence";
+  constexpr int kCutFrom = 15, kCut = 8, kFrames = 40;
+  std::vector<StampedPose> poses = ReadTum(sequence / "groundtruth.tum");
+  poses.erase(poses.begin() + kCutFrom, poses.begin() + kCutFrom + kCut);
+  for (size_t i = 0; i < poses.size(); ++i) poses[i].timestamp = static_cast<double>(i) / 30;
+  WriteTum(sequence / "groundtruth.tum", poses);
+  for (int frame = kCutFrom + kCut; frame < kFrames; ++frame) {
+    for (const char* images : {"rgb", "depth"}) {
+      fs::rename(sequence / images / FrameFileName(frame), sequence / images / FrameFileName(frame - kCut));
+    }
+  }
+  nlohmann::json info = ReadJsonFile(sequence / "sequence.json");
+  info["frame_count"] = kFrames - kCut;
+  std::ofstream(sequence / "sequence.json") << info.dump(2);
+
+  const RunSummary cut = RunSequence(sequence, TrackingExperiment(), folder / "run");
+  EXPECT_EQ(cut.frames_tracked, kFrames - kCut);
+  EXPECT_EQ(cut.view_jumps, 1);
+  EXPECT_EQ(ReadJsonFile(folder / "run" / "summary.json").at("view_jumps"), 1);
+  const auto metrics = ReadCsv(folder / "run" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), static_cast<size_t>(kFrames - kCut));
+  EXPECT_NE(metrics[kCutFrom].at("note").find("the view jumped"), std::string::npos) << metrics[kCutFrom].at("note");
+  EXPECT_EQ(CountLines(folder / "run" / "metrics.csv", "the view jumped"), 1);
+  EXPECT_NE(DescribeSummary(cut).find("1 jump of the view"), std::string::npos) << DescribeSummary(cut);
+  SystemOptions unnoted = TrackingExperiment();
+  unnoted.tracking.jump_flow_ratio = 0;
+  EXPECT_EQ(RunSequence(sequence, unnoted, folder / "unnoted").view_jumps, 0);
 }
 
 // An instrument over most of the view hides more than half of the map's tracks, but those it

@@ -43,6 +43,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->frames_groundtruth_unreadable = json.value("frames_groundtruth_unreadable", 0);
   result->frames_dropout = json.value("frames_dropout", 0);
   result->sudden_occlusions = json.value("sudden_occlusions", 0);
+  result->view_jumps = json.value("view_jumps", 0);
   result->static_fraction = json.value("static_fraction", 0.0);
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
@@ -207,7 +208,8 @@ std::string StopText(const RunResult& result) {
 
 std::vector<std::string> RunNotes(const RunResult& result) {
   std::vector<std::string> notes = InputNotes(result.frames_unreadable, result.frames_groundtruth_unreadable,
-                                              result.frames_dropout, result.sudden_occlusions, result.static_fraction);
+                                              result.frames_dropout, result.sudden_occlusions, result.view_jumps,
+                                              result.static_fraction);
   const std::string stop = StopText(result);
   if (!stop.empty()) notes.insert(notes.begin(), stop);
   return notes;
@@ -303,6 +305,7 @@ Json ToJson(const std::vector<RunResult>& results) {
                     {"frames_unreadable_after_init", r.frames_unreadable_after_init},
                     {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable},
                     {"frames_dropout", r.frames_dropout}, {"sudden_occlusions", r.sudden_occlusions},
+                    {"view_jumps", r.view_jumps},
                     {"static_fraction", r.static_fraction}, {"rmse_mm", r.rmse_mm},
                     {"rmse_median_mm", r.rmse_median_mm},
                     {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
@@ -351,14 +354,15 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
          "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_dropout,"
-         "sudden_occlusions,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,"
+         "sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,"
          "ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,"
          "error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
         << r.frames_unreadable << ',' << r.frames_unreadable_after_init << ',' << r.frames_groundtruth_unreadable << ','
-        << r.frames_dropout << ',' << r.sudden_occlusions << ',' << r.static_fraction << ',' << r.rmse_mm
+        << r.frames_dropout << ',' << r.sudden_occlusions << ',' << r.view_jumps << ',' << r.static_fraction << ','
+        << r.rmse_mm
         << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','

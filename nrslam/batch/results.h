@@ -26,6 +26,7 @@ struct RunResult {
   int frames_groundtruth_unreadable = 0;  // tracked frames not scored: their ground-truth file was unreadable
   int frames_dropout = 0;                 // frames lost as image dropouts, the map kept
   int sudden_occlusions = 0;              // tracked frames that lost most of the view at once (RunSummary)
+  int view_jumps = 0;                     // tracked frames whose view jumped (RunSummary)
   double static_fraction = 0;             // share of the image left out as never changing (RunSummary)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   double peak_memory_mb = -1;       // the run process's peak resident memory; negative: not recorded

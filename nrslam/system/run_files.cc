@@ -45,6 +45,13 @@ std::string OcclusionText(int sudden_occlusions) {
          ": most of the view hidden at once, the tracks left matching well (the frames used; metrics.csv notes them)";
 }
 
+std::string ViewJumpText(int view_jumps) {
+  if (view_jumps == 0) return "";
+  return std::to_string(view_jumps) + (view_jumps == 1 ? " jump of the view" : " jumps of the view") +
+         ": its tracks moved far more than over the frames before (frames missing from the recording, or a jerk "
+         "of the scope; metrics.csv notes them)";
+}
+
 std::string StaticRegionText(double static_fraction) {
   if (static_fraction <= 0) return "";
   std::ostringstream text;
@@ -55,10 +62,10 @@ std::string StaticRegionText(double static_fraction) {
 }
 
 std::vector<std::string> InputNotes(int frames_unreadable, int frames_groundtruth_unreadable, int frames_dropout,
-                                    int sudden_occlusions, double static_fraction) {
+                                    int sudden_occlusions, int view_jumps, double static_fraction) {
   std::vector<std::string> notes;
   for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
-                           DropoutText(frames_dropout), OcclusionText(sudden_occlusions),
+                           DropoutText(frames_dropout), OcclusionText(sudden_occlusions), ViewJumpText(view_jumps),
                            StaticRegionText(static_fraction)}) {
     if (!note.empty()) notes.push_back(std::move(note));
   }
@@ -105,7 +112,7 @@ std::string DescribeSummary(const RunSummary& summary) {
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
   for (const std::string& note : InputNotes(summary.frames_unreadable, summary.frames_groundtruth_unreadable,
-                                            summary.frames_dropout, summary.sudden_occlusions,
+                                            summary.frames_dropout, summary.sudden_occlusions, summary.view_jumps,
                                             summary.static_fraction)) {
     text << '\n' << note;
   }
@@ -191,6 +198,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
                       {"frames_dropout", summary.frames_dropout},
                       {"sudden_occlusions", summary.sudden_occlusions},
+                      {"view_jumps", summary.view_jumps},
                       {"static_fraction", summary.static_fraction},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},

@@ -45,6 +45,9 @@ struct RunSummary {
   // Frames tracked although most of the view was hidden at once (FrameResult::sudden_occlusion):
   // one per occlusion, not per frame it lasts.
   int sudden_occlusions = 0;
+  // Frames tracked although the view jumped (FrameResult::view_jump): frames missing from the
+  // recording, or a jerk of the scope.
+  int view_jumps = 0;
   // The share of the image left out because it never changed over the run (an on-screen
   // display, an unmasked black border; frontend FindStaticRegions, margin included).
   double static_fraction = 0;
@@ -85,14 +88,19 @@ std::string DropoutText(int frames_dropout);
 // frames used; metrics.csv notes them)"; "" when none.
 std::string OcclusionText(int sudden_occlusions);
 
+// "1 jump of the view: its tracks moved far more than over the frames before (frames missing
+// from the recording, or a jerk of the scope; metrics.csv notes them)"; "" when none.
+std::string ViewJumpText(int view_jumps);
+
 // "9.9 % of the image never changed (an on-screen display, a black border or background) and
 // was left out (static_mask.png)"; "" when none.
 std::string StaticRegionText(double static_fraction);
 
 // What the input did to a run, one note each, those that apply, in the order the runner and
-// nrslam_eval print them: unreadable files, image dropouts, sudden occlusions, static regions.
+// nrslam_eval print them: unreadable files, image dropouts, sudden occlusions, jumps of the view,
+// static regions.
 std::vector<std::string> InputNotes(int frames_unreadable, int frames_groundtruth_unreadable, int frames_dropout,
-                                    int sudden_occlusions, double static_fraction);
+                                    int sudden_occlusions, int view_jumps, double static_fraction);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked

@@ -252,6 +252,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
           log << "frame " << frame << ": " << result.note << '\n';
         }
         summary.sudden_occlusions += result.sudden_occlusion;
+        summary.view_jumps += result.view_jump;
         if (result.state == TrackingState::kTracking && options.run.mapping) {
           mapping = mapper.Process(result, bgr, mask, &tracker);
           result.cam_from_world = tracker.pose();  // the DBA may have refined it

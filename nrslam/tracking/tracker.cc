@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <map>
+#include <sstream>
 #include <utility>
 
 #include "nrslam/camera/reprojection_cost.h"
@@ -91,6 +93,27 @@ Tracker::Tracker(const Camera& camera, const FrontendOptions& frontend, const De
   options_.Check();
 }
 
+void Tracker::NoteViewJump(FrameResult* result) {
+  if (flows_px_.empty()) return;
+  const double flow = MedianInPlace(&flows_px_);
+  constexpr size_t kRecentFrames = 10, kFewestToCompare = 3;
+  constexpr double kSlowestRecentPx = 1.0;  // a still view's sub-pixel jitter is no scale to judge by
+  if (options_.jump_flow_ratio > 0 && recent_flows_px_.size() >= kFewestToCompare) {
+    std::vector<double> recent(recent_flows_px_.begin(), recent_flows_px_.end());
+    const double usual = std::max(MedianInPlace(&recent), kSlowestRecentPx);
+    if (flow > options_.jump_flow_ratio * usual) {
+      result->view_jump = true;
+      std::ostringstream text;
+      text << std::fixed << std::setprecision(1) << "the view jumped: its tracks moved " << flow / usual
+           << " times as far as over the recent frames (" << flow << " against " << usual
+           << " px): frames missing from the recording, or a jerk of the scope";
+      result->note += (result->note.empty() ? "" : "; ") + text.str();
+    }
+  }
+  recent_flows_px_.push_back(flow);
+  if (recent_flows_px_.size() > kRecentFrames) recent_flows_px_.pop_front();
+}
+
 FrameResult Tracker::Lost(FrameResult result, const std::string& why) {
   state_ = state_ == TrackingState::kNotInitialised ? state_ : TrackingState::kLost;
   result.state = state_;
@@ -158,6 +181,7 @@ FrameResult Tracker::InitialiseFromSeed(int frame, const cv::Mat& bgr, const cv:
   cam_from_world_ = seed.cam_from_world;
   motion_ = Rigid3();
   dropouts_.Reset();
+  recent_flows_px_.clear();
   RefreshReference(frame, std::make_shared<const ImagePyramid>(grey, frontend_.klt.levels),
                    BuildValidityMask(grey, mask, frontend_.masks));
   state_ = TrackingState::kTracking;
@@ -682,6 +706,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
   }
   std::vector<Observation> observations;
   lost_now_.clear();
+  flows_px_.clear();
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (!tracks_[i].active) continue;
     if (matches[i].status != KltStatus::kTracked) {
@@ -689,6 +714,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
       if (LoseTrack(&tracks_[i], frame, result.sudden_occlusion)) lost_now_.push_back(tracks_[i].id);
       continue;
     }
+    if (tracks_[i].id != kNoPoint) flows_px_.push_back(cv::norm(matches[i].position - tracks_[i].pixel));
     tracks_[i].pixel = matches[i].position;
     if (tracks_[i].id == kNoPoint) {
       result.candidates.push_back({tracks_[i].track_id, tracks_[i].pixel});
@@ -696,6 +722,7 @@ FrameResult Tracker::Track(int frame, const cv::Mat& bgr, const cv::Mat& mask, c
     }
     observations.push_back({i, tracks_[i].id, Eigen::Vector2d(matches[i].position.x, matches[i].position.y)});
   }
+  NoteViewJump(&result);
   result.klt_tracked = static_cast<int>(observations.size());
   MarkHiddenLosses(frame);
   result.ms_klt = MillisecondsSince(start);

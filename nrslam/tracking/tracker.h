@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -70,6 +71,9 @@ struct FrameResult {
   // Tracked although most of the map's tracks vanished at once, because those left matched well
   // (ImageDropouts::SuddenOcclusion).
   bool sudden_occlusion = false;
+  // Tracked although its tracks moved far more than over the recent frames
+  // (TrackingOptions::jump_flow_ratio): frames missing, or a jerk of the scope.
+  bool view_jump = false;
 };
 
 // `motions` less their mean: the part of the points' motion the camera cannot take over. The
@@ -185,6 +189,8 @@ class Tracker {
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
   ImageDropouts dropouts_{options_};
   std::vector<ImageDropouts::LiveTrack> map_tracks_;  // the dropout rule's input, re-filled every frame
+  std::vector<double> flows_px_;           // how far each map track moved this frame (re-filled every frame)
+  std::deque<double> recent_flows_px_;     // the median of flows_px_ over the last tracked frames
   // By point id: how far the last frame's tracking moved it (with deformation_motion_seed;
   // during the deformation stage, where each point started).
   std::vector<Eigen::Vector3d> point_motion_;
@@ -257,6 +263,9 @@ class Tracker {
   // within the gate (`near`) or beyond it (`far`).
   bool MovedWithItsNeighbours(const FoundAgain& point, const std::vector<FoundAgain>& near,
                               const std::vector<FoundAgain>& far);
+  // Notes on `result` a frame whose map tracks moved far more than over the recent frames
+  // (flows_px_, TrackingOptions::jump_flow_ratio), and adds its median flow to the recent ones.
+  void NoteViewJump(FrameResult* result);
   FrameResult Lost(FrameResult result, const std::string& why);
 };
 

@@ -8,6 +8,7 @@ void TrackingOptions::Check() const {
   CheckOption(max_points >= 10, "tracking", "max_points must be >= 10");
   CheckOption(keyframe_period >= 1, "tracking", "keyframe_period must be >= 1");
   CheckOption(min_points >= 3, "tracking", "min_points must be >= 3");
+  CheckOption(jump_flow_ratio == 0 || jump_flow_ratio >= 1, "tracking", "jump_flow_ratio must be 0 (no note) or >= 1");
   CheckOption(max_dropout_frames >= 0, "tracking", "max_dropout_frames must be >= 0 (0: a dropout is lost at once)");
   CheckOption(min_tracked_fraction >= 0 && min_tracked_fraction <= 1, "tracking",
               "min_tracked_fraction must be in [0, 1]");
