@@ -354,16 +354,15 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
          "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_dropout,"
-         "sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,rmse_median_scale_mm,"
-         "ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,"
-         "error\n";
+         "sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,"
+         "rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
+         "birth_log_error_median,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
         << r.frames_unreadable << ',' << r.frames_unreadable_after_init << ',' << r.frames_groundtruth_unreadable << ','
         << r.frames_dropout << ',' << r.sudden_occlusions << ',' << r.view_jumps << ',' << r.static_fraction << ','
-        << r.rmse_mm
-        << ',' << r.rmse_median_mm << ','
+        << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
