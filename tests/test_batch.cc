@@ -614,6 +614,16 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_EQ(read[1].sudden_occlusions, 0);
   EXPECT_EQ(read[0].view_jumps, 1);
   EXPECT_EQ(read[1].view_jumps, 0);
+  const auto csv_folder = UniqueTempFolder("results_notes_csv");
+  WriteResults({damaged}, csv_folder);
+  std::ifstream csv(csv_folder / "results.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_NE(header.find(",frames_dropout,sudden_occlusions,view_jumps,static_fraction,"), std::string::npos) << header;
+  EXPECT_NE(row.find(",3,2,1,0.125,"), std::string::npos) << row;
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','), std::count(row.begin(), row.end(), ','));
+  std::filesystem::remove_all(csv_folder);
   EXPECT_EQ(read[0].static_fraction, 0.125);
   EXPECT_EQ(read[1].static_fraction, 0);
 }
