@@ -34,8 +34,8 @@ struct TrackingOptions {
   // least 1 px) is noted as a jump of the view: frames missing from the recording, or a jerk of
   // the scope. The tissue then moved as far as over several frames, more than the per-frame
   // regularisers allow, and the error rises (sim-3 from depth with 10 frames cut out: 0.65 →
-  // 3.8 mm, and it stays). On the suites' renderings the ratio stays under 2.2; frames cut out
-  // of sim-3 give 4.8 (5 frames) and 6.4 (10). A note only: 0 = none.
+  // 3.8 mm, and it stays). On the suites' renderings the ratio stays under 2.2 (from their
+  // points.csv); frames cut out of sim-3 give 4.9 (5 frames) and 6.1 (10). A note only: 0 = none.
   double jump_flow_ratio = 4;
   int pose_rounds = 3;                // rigid pose-only refinement: outlier rounds ...
   int pose_iterations = 10;           // ... of this many LM iterations each
