@@ -99,8 +99,8 @@ void Tracker::NoteViewJump(FrameResult* result) {
   constexpr size_t kRecentFrames = 10, kFewestToCompare = 3;
   constexpr double kSlowestRecentPx = 1.0;  // a still view's sub-pixel jitter is no scale to judge by
   if (options_.jump_flow_ratio > 0 && recent_flows_px_.size() >= kFewestToCompare) {
-    std::vector<double> recent(recent_flows_px_.begin(), recent_flows_px_.end());
-    const double usual = std::max(MedianInPlace(&recent), kSlowestRecentPx);
+    flows_px_.assign(recent_flows_px_.begin(), recent_flows_px_.end());  // this frame's are done with
+    const double usual = std::max(MedianInPlace(&flows_px_), kSlowestRecentPx);
     if (flow > options_.jump_flow_ratio * usual) {
       result->view_jump = true;
       std::ostringstream text;

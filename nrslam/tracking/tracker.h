@@ -189,7 +189,8 @@ class Tracker {
   Rigid3 motion_;  // last frame-to-frame motion, for the constant-velocity seed
   ImageDropouts dropouts_{options_};
   std::vector<ImageDropouts::LiveTrack> map_tracks_;  // the dropout rule's input, re-filled every frame
-  std::vector<double> flows_px_;           // how far each map track moved this frame (re-filled every frame)
+  // How far each map track moved this frame (re-filled every frame; NoteViewJump then re-uses it).
+  std::vector<double> flows_px_;
   std::deque<double> recent_flows_px_;     // the median of flows_px_ over the last tracked frames
   // By point id: how far the last frame's tracking moved it (with deformation_motion_seed;
   // during the deformation stage, where each point started).
