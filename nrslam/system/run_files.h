@@ -48,7 +48,7 @@ struct RunSummary {
   // Frames tracked although the view jumped (FrameResult::view_jump): frames missing from the
   // recording, or a jerk of the scope.
   int view_jumps = 0;
-  // The share of the image left out because it never changed over the run (an on-screen
+  // The share of the image left out because it never changed over the sequence (an on-screen
   // display, an unmasked black border; frontend FindStaticRegions, margin included).
   double static_fraction = 0;
   double fps = 0;          // frames processed per second of wall time (reading included)

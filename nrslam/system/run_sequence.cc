@@ -25,6 +25,7 @@
 #include "nrslam/util/memory_usage.h"
 #include "nrslam/util/stopwatch.h"
 #include "nrslam/util/text_file.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -68,11 +69,9 @@ cv::Mat StaticRegionsOfSequence(const SequenceReader& reader, const MaskOptions&
   const int span = reader.frame_count();
   const double seconds = span / reader.info().fps;
   if (seconds < options.static_min_seconds) {
-    std::ostringstream note;
-    note << std::fixed << std::setprecision(1) << "not looked for regions that never change (an on-screen display): "
-         << "the sequence spans " << seconds << " s, under static_min_seconds = " << options.static_min_seconds
-         << " s\n";
-    log << note.str();
+    log << "not looked for regions that never change (an on-screen display): the sequence spans "
+        << FormatFixed(seconds, 1) << " s, under static_min_seconds = " << FormatFixed(options.static_min_seconds, 1)
+        << " s\n";
     return {};
   }
   const int samples = std::min(options.static_frames, span);

@@ -8,9 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <iomanip>
 #include <map>
-#include <sstream>
 #include <utility>
 
 #include "nrslam/camera/reprojection_cost.h"
@@ -22,6 +20,7 @@
 #include "nrslam/util/concurrent.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/stopwatch.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 namespace {
@@ -103,11 +102,10 @@ void Tracker::NoteViewJump(FrameResult* result) {
     const double usual = std::max(MedianInPlace(&flows_px_), kSlowestRecentPx);
     if (flow > options_.jump_flow_ratio * usual) {
       result->view_jump = true;
-      std::ostringstream text;
-      text << std::fixed << std::setprecision(1) << "the view jumped: its tracks moved " << flow / usual
-           << " times as far as over the recent frames (" << flow << " against " << usual
-           << " px): frames missing from the recording, or a jerk of the scope";
-      result->note += (result->note.empty() ? "" : "; ") + text.str();
+      if (!result->note.empty()) result->note += "; ";
+      result->note += "the view jumped: its tracks moved " + FormatFixed(flow / usual, 1) +
+                      " times as far as over the recent frames (" + FormatFixed(flow, 1) + " against " +
+                      FormatFixed(usual, 1) + " px): frames missing from the recording, or a jerk of the scope";
     }
   }
   recent_flows_px_.push_back(flow);
