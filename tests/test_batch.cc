@@ -516,6 +516,16 @@ TEST(Results, RunsWithoutGroundTruthShowNoRmse) {
   const std::vector<RunResult> read = ResultsFromJson(ToJson({video, simulated}));
   EXPECT_FALSE(read[0].evaluated());
   EXPECT_EQ(read[1].frames_evaluated, 42);
+  // Ground truth too sparse to score any frame is not shown as none, and the row says why.
+  RunResult sparse = video;
+  sparse.sequence = "sparse";
+  sparse.input.frames_sparse_groundtruth = 42;
+  std::stringstream sparse_table;
+  PrintResults({sparse}, sparse_table);
+  EXPECT_NE(sparse_table.str().find("sparse GT"), std::string::npos) << sparse_table.str();
+  EXPECT_EQ(sparse_table.str().find("no GT"), std::string::npos) << sparse_table.str();
+  EXPECT_NE(sparse_table.str().find("42 tracked frames not scored"), std::string::npos) << sparse_table.str();
+  EXPECT_EQ(ResultsFromJson(ToJson({sparse}))[0].input.frames_sparse_groundtruth, 42);
   // results.json from before the field: every tracked frame had ground truth.
   Json old = ToJson({simulated});
   old["results"][0].erase("frames_evaluated");
@@ -567,13 +577,13 @@ TEST(Results, WhereAndWhyARunStoppedIsShownAndKept) {
 TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept) {
   RunResult damaged = Result("sim-2", 0.5, 60);
   damaged.frames_evaluated = 58;
-  damaged.frames_unreadable = 1;
-  damaged.frames_unreadable_after_init = 1;
-  damaged.frames_groundtruth_unreadable = 2;
-  damaged.frames_dropout = 3;
-  damaged.sudden_occlusions = 2;
-  damaged.view_jumps = 1;
-  damaged.static_fraction = 0.125;
+  damaged.input.frames_unreadable = 1;
+  damaged.input.frames_unreadable_after_init = 1;
+  damaged.input.frames_groundtruth_unreadable = 2;
+  damaged.input.frames_dropout = 3;
+  damaged.input.sudden_occlusions = 2;
+  damaged.input.view_jumps = 1;
+  damaged.input.static_fraction = 0.125;
   const RunResult fine = Result("sim-0", 0.1, 60);
   std::stringstream table;
   PrintResults({damaged, fine}, table);
@@ -603,17 +613,17 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_NE(html.find("<p>3 frames skipped as image dropouts (lost; the map kept)</p>"), std::string::npos) << html;
   std::filesystem::remove_all(folder);
   const std::vector<RunResult> read = ResultsFromJson(ToJson({damaged, fine}));
-  EXPECT_EQ(read[0].frames_unreadable, 1);
-  EXPECT_EQ(read[0].frames_unreadable_after_init, 1);
-  EXPECT_EQ(read[1].frames_unreadable_after_init, 0);
-  EXPECT_EQ(read[0].frames_groundtruth_unreadable, 2);
-  EXPECT_EQ(read[1].frames_groundtruth_unreadable, 0);
-  EXPECT_EQ(read[0].frames_dropout, 3);
-  EXPECT_EQ(read[1].frames_dropout, 0);
-  EXPECT_EQ(read[0].sudden_occlusions, 2);
-  EXPECT_EQ(read[1].sudden_occlusions, 0);
-  EXPECT_EQ(read[0].view_jumps, 1);
-  EXPECT_EQ(read[1].view_jumps, 0);
+  EXPECT_EQ(read[0].input.frames_unreadable, 1);
+  EXPECT_EQ(read[0].input.frames_unreadable_after_init, 1);
+  EXPECT_EQ(read[1].input.frames_unreadable_after_init, 0);
+  EXPECT_EQ(read[0].input.frames_groundtruth_unreadable, 2);
+  EXPECT_EQ(read[1].input.frames_groundtruth_unreadable, 0);
+  EXPECT_EQ(read[0].input.frames_dropout, 3);
+  EXPECT_EQ(read[1].input.frames_dropout, 0);
+  EXPECT_EQ(read[0].input.sudden_occlusions, 2);
+  EXPECT_EQ(read[1].input.sudden_occlusions, 0);
+  EXPECT_EQ(read[0].input.view_jumps, 1);
+  EXPECT_EQ(read[1].input.view_jumps, 0);
   const auto csv_folder = UniqueTempFolder("results_notes_csv");
   WriteResults({damaged}, csv_folder);
   std::ifstream csv(csv_folder / "results.csv");
@@ -624,8 +634,8 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_NE(row.find(",3,2,1,0.125,"), std::string::npos) << row;
   EXPECT_EQ(std::count(header.begin(), header.end(), ','), std::count(row.begin(), row.end(), ','));
   std::filesystem::remove_all(csv_folder);
-  EXPECT_EQ(read[0].static_fraction, 0.125);
-  EXPECT_EQ(read[1].static_fraction, 0);
+  EXPECT_EQ(read[0].input.static_fraction, 0.125);
+  EXPECT_EQ(read[1].input.static_fraction, 0);
 }
 
 // A run is "lost" when it leaves frames after its initialisation untracked, or ends without
@@ -640,15 +650,15 @@ TEST(Results, StatusFromTheFigures) {
   EXPECT_EQ(RunStatus(r), "ok");
   r.frames_tracked = 116;
   EXPECT_EQ(RunStatus(r), "lost");  // one frame lost on the way (e.g. a new map started after it)
-  r.frames_dropout = 1;
+  r.input.frames_dropout = 1;
   EXPECT_EQ(RunStatus(r), "ok");    // that frame was skipped as an image dropout
-  r.frames_dropout = 0;
-  r.frames_unreadable = 2;
+  r.input.frames_dropout = 0;
+  r.input.frames_unreadable = 2;
   EXPECT_EQ(RunStatus(r), "lost");  // unreadable, but the figures do not say the frame came after the start
-  r.frames_unreadable_after_init = 1;
+  r.input.frames_unreadable_after_init = 1;
   EXPECT_EQ(RunStatus(r), "ok");    // it did: the input's, not the tracker's
-  r.frames_unreadable_after_init = 0;
-  r.frames_dropout = 1;
+  r.input.frames_unreadable_after_init = 0;
+  r.input.frames_dropout = 1;
   r.stop_frame = 119;
   r.stop_reason = "only 0 of 180 points tracked: skipped as an image dropout, the map kept (1 of at most 5 in a row)";
   EXPECT_EQ(RunStatus(r), "lost");  // skipped at the end: the run ends without tracking

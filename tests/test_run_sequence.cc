@@ -150,10 +150,10 @@ TEST_F(RunSequenceTest, TracksEveryFrameAndBeatsAFrozenMapByFar) {
   EXPECT_EQ(summary_->frames_evaluated, 40);
   EXPECT_LT(summary_->rmse_mm, 2.0);
   // 40 frames are 1.3 s: too short to tell a display from tissue the camera has barely moved past.
-  EXPECT_EQ(summary_->static_fraction, 0);
+  EXPECT_EQ(summary_->input.static_fraction, 0);
   EXPECT_FALSE(fs::exists(*base_ / "run" / "static_mask.png"));
   EXPECT_EQ(CountLines(*base_ / "run" / "run.log", "the sequence spans 1.3 s, under static_min_seconds = 3.5 s"), 1);
-  EXPECT_EQ(summary_->view_jumps, 0);
+  EXPECT_EQ(summary_->input.view_jumps, 0);
   // What a tracker that never moved would score: every tracked point at its initial depth.
   const SequenceReader reader(*base_ / "sequence");
   const std::vector<CsvPoint> points = ReadPointsCsv(*base_ / "run" / "points.csv");
@@ -1073,8 +1073,8 @@ TEST(RunSequenceErrors, CorruptFrameMidRunIsRecordedAndTheRunGoesOn) {
   const RunSummary summary = RunSequence(folder, options, folder / "run");
   EXPECT_EQ(summary.frames_tracked, 9);
   EXPECT_EQ(summary.frames_lost, 1);
-  EXPECT_EQ(summary.frames_unreadable, 1);
-  EXPECT_EQ(summary.frames_unreadable_after_init, 1);  // the map started on frame 0
+  EXPECT_EQ(summary.input.frames_unreadable, 1);
+  EXPECT_EQ(summary.input.frames_unreadable_after_init, 1);  // the map started on frame 0
   EXPECT_NE(DescribeSummary(summary).find("1 frame unreadable (lost); metrics.csv names the files"), std::string::npos)
       << DescribeSummary(summary);
   const std::vector<std::string> rows = FileLines(folder / "run" / "metrics.csv");
@@ -1107,8 +1107,8 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   EXPECT_EQ(damaged.frames_lost, 0);
   EXPECT_EQ(whole.frames_evaluated, 10);
   EXPECT_EQ(damaged.frames_evaluated, 9);
-  EXPECT_EQ(whole.frames_groundtruth_unreadable, 0);
-  EXPECT_EQ(damaged.frames_groundtruth_unreadable, 1);
+  EXPECT_EQ(whole.input.frames_groundtruth_unreadable, 0);
+  EXPECT_EQ(damaged.input.frames_groundtruth_unreadable, 1);
   for (const char* file : {"trajectory.tum", "points.csv"}) {
     EXPECT_EQ(FileLines(folder / "damaged_run" / file), FileLines(folder / "whole_run" / file)) << file;
   }
@@ -1121,7 +1121,7 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   EXPECT_NE(DescribeSummary(damaged).find("ground-truth depth unreadable on 1 tracked frame (not scored)"),
             std::string::npos)
       << DescribeSummary(damaged);
-  EXPECT_EQ(damaged.frames_unreadable, 0);
+  EXPECT_EQ(damaged.input.frames_unreadable, 0);
 
   ExternalResult external;
   external.estimates = folder / "whole_run" / "points.csv";
@@ -1129,7 +1129,7 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   const RunSummary scored = ScoreExternalResult(folder / "damaged", external, EvaluationOptions{}, folder / "scored");
   EXPECT_EQ(scored.frames_tracked, 10);
   EXPECT_EQ(scored.frames_evaluated, 9);
-  EXPECT_EQ(scored.frames_groundtruth_unreadable, 1);
+  EXPECT_EQ(scored.input.frames_groundtruth_unreadable, 1);
   EXPECT_NEAR(scored.rmse_mm, damaged.rmse_mm, 1e-5);
   EXPECT_EQ(CompareRunFolders(folder / "damaged_run", folder / "damaged_run").frames, 9);
 
@@ -1137,11 +1137,64 @@ TEST(RunSequenceErrors, UnreadableGroundTruthCostsItsFrameTheScoreOnly) {
   const RunSummary late = RunSequence(folder / "damaged", TrackingExperiment(), folder / "late_run");
   EXPECT_EQ(late.init_frame, 1);
   EXPECT_EQ(late.frames_tracked, 9);
-  EXPECT_EQ(late.frames_unreadable, 1);  // where the map starts, depth is input
-  EXPECT_EQ(late.frames_unreadable_after_init, 0);  // before the map: counted in init_frame
+  EXPECT_EQ(late.input.frames_unreadable, 1);  // where the map starts, depth is input
+  EXPECT_EQ(late.input.frames_unreadable_after_init, 0);  // before the map: counted in init_frame
   const std::vector<std::string> late_metrics = FileLines(folder / "late_run" / "metrics.csv");
   ASSERT_EQ(late_metrics.size(), 11u);
   EXPECT_NE(late_metrics[1].find("000000.png"), std::string::npos) << late_metrics[1];
+  fs::remove_all(folder);
+}
+
+// Ground truth read but valid under too few of a frame's points (depth missing over most of the
+// view) costs that frame its score, and the run says so: in metrics.csv, the summary line and
+// summary.json. A run with no frame scored for that reason does not claim to have no ground truth.
+TEST(RunSequenceErrors, GroundTruthTooSparseToScoreIsNotedNotMistakenForNone) {
+  const fs::path folder = UniqueTempFolder("nrslam_sparse_groundtruth");
+  fs::remove_all(folder);
+  SimulateSmall("sim-1", 10, 320, 240, folder / "whole");
+  fs::copy(folder / "whole", folder / "sparse", fs::copy_options::recursive);
+  const auto keep_one_pixel = [&](int frame) {
+    const fs::path file = folder / "sparse" / "depth" / FrameFileName(frame);
+    const cv::Mat depth = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+    cv::Mat sparse = cv::Mat::zeros(depth.size(), depth.type());
+    depth(cv::Rect(160, 120, 1, 1)).copyTo(sparse(cv::Rect(160, 120, 1, 1)));
+    ASSERT_TRUE(cv::imwrite(file.string(), sparse));
+  };
+  for (int frame : {4, 5, 6}) keep_one_pixel(frame);
+  const RunSummary whole = RunSequence(folder / "whole", TrackingExperiment(), folder / "whole_run");
+  const RunSummary sparse = RunSequence(folder / "sparse", TrackingExperiment(), folder / "sparse_run");
+  EXPECT_EQ(sparse.frames_tracked, 10);
+  EXPECT_EQ(whole.frames_evaluated, 10);
+  EXPECT_EQ(sparse.frames_evaluated, 7);
+  EXPECT_EQ(whole.input.frames_sparse_groundtruth, 0);
+  EXPECT_EQ(sparse.input.frames_sparse_groundtruth, 3);
+  EXPECT_EQ(sparse.input.frames_groundtruth_unreadable, 0);
+  EXPECT_EQ(FileLines(folder / "sparse_run" / "points.csv"), FileLines(folder / "whole_run" / "points.csv"));
+  const std::vector<std::string> metrics = FileLines(folder / "sparse_run" / "metrics.csv");
+  ASSERT_EQ(metrics.size(), 11u);
+  EXPECT_TRUE(std::regex_search(metrics[5], std::regex(R"(not scored: 0 of its \d+ points on valid ground truth)")))
+      << metrics[5];
+  EXPECT_EQ(metrics[4].find("not scored"), std::string::npos) << metrics[4];
+  EXPECT_EQ(ReadJsonFile(folder / "sparse_run" / "summary.json").at("frames_sparse_groundtruth"), 3);
+  const std::string described = DescribeSummary(sparse);
+  EXPECT_NE(described.find("RMSE mean"), std::string::npos) << described;
+  EXPECT_NE(described.find("3 tracked frames not scored: too few of their points on valid ground truth"),
+            std::string::npos)
+      << described;
+
+  // Scored from outside, with every frame's ground truth that sparse: no RMSE, and why.
+  for (int frame = 0; frame < 10; ++frame) keep_one_pixel(frame);
+  ExternalResult external;
+  external.estimates = folder / "whole_run" / "points.csv";
+  external.trajectory = folder / "whole_run" / "trajectory.tum";
+  const RunSummary scored = ScoreExternalResult(folder / "sparse", external, EvaluationOptions{}, folder / "scored");
+  EXPECT_EQ(scored.frames_tracked, 10);
+  EXPECT_EQ(scored.frames_evaluated, 0);
+  EXPECT_EQ(scored.input.frames_sparse_groundtruth, 10);
+  EXPECT_NE(DescribeSummary(scored).find("no RMSE: the ground truth is too sparse to score any frame"),
+            std::string::npos)
+      << DescribeSummary(scored);
+  EXPECT_EQ(DescribeSummary(scored).find("no ground truth"), std::string::npos) << DescribeSummary(scored);
   fs::remove_all(folder);
 }
 
@@ -1213,7 +1266,7 @@ TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {
   options.tracking.max_dropout_frames = 1;
   const RunSummary stopped = RunSequence(folder, options, folder / "stopped");
   EXPECT_EQ(stopped.frames_tracked, 7);
-  EXPECT_EQ(stopped.frames_dropout, 1);
+  EXPECT_EQ(stopped.input.frames_dropout, 1);
   EXPECT_EQ(stopped.Status(), "lost");
   EXPECT_EQ(stopped.stop_frame, 7);
   EXPECT_NE(stopped.stop_reason.find("points tracked: skipped as an image dropout"), std::string::npos)
@@ -1237,7 +1290,7 @@ void ExpectLostFromFrame(const fs::path& folder, const SystemOptions& options, i
   EXPECT_EQ(stopped.Status(), "lost");
   EXPECT_EQ(stopped.stop_frame, frame);
   EXPECT_EQ(stopped.frames_tracked, frame);
-  EXPECT_EQ(stopped.frames_dropout, 0);
+  EXPECT_EQ(stopped.input.frames_dropout, 0);
 }
 
 // A few blank frames in the middle of a run (a flush, the lens against the tissue) are skipped
@@ -1255,8 +1308,8 @@ TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
   EXPECT_EQ(skipped.maps, 1);
   EXPECT_EQ(skipped.frames_tracked, 37);
   EXPECT_EQ(skipped.frames_lost, 3);
-  EXPECT_EQ(skipped.frames_dropout, 3);
-  EXPECT_EQ(skipped.frames_unreadable, 0);
+  EXPECT_EQ(skipped.input.frames_dropout, 3);
+  EXPECT_EQ(skipped.input.frames_unreadable, 0);
   EXPECT_NE(DescribeSummary(skipped).find("3 frames skipped as image dropouts (lost; the map kept)"), std::string::npos)
       << DescribeSummary(skipped);
   const auto metrics = ReadCsv(folder / "skipped" / "metrics.csv");
@@ -1293,7 +1346,7 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
   const RunSummary skipped = RunSequence(folder / "sequence", TrackingExperiment(), folder / "skipped");
   EXPECT_EQ(skipped.Status(), "ok");
   EXPECT_EQ(skipped.frames_tracked, 39);
-  EXPECT_EQ(skipped.frames_dropout, 1);
+  EXPECT_EQ(skipped.input.frames_dropout, 1);
   const auto metrics = ReadCsv(folder / "skipped" / "metrics.csv");
   ASSERT_EQ(metrics.size(), 40u);
   EXPECT_GE(std::stoi(metrics[15].at("klt_tracked")), TrackingOptions{}.min_points);  // the count alone would pass it
@@ -1341,8 +1394,8 @@ TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   checked.frontend.masks.static_min_seconds = 1;
   const RunSummary left_out = RunSequence(folder / "sequence", checked, folder / "left_out");
   EXPECT_EQ(left_out.frames_tracked, 40);
-  EXPECT_GT(left_out.static_fraction, 0.02);
-  EXPECT_EQ(ReadJsonFile(folder / "left_out" / "summary.json").at("static_fraction"), left_out.static_fraction);
+  EXPECT_GT(left_out.input.static_fraction, 0.02);
+  EXPECT_EQ(ReadJsonFile(folder / "left_out" / "summary.json").at("static_fraction"), left_out.input.static_fraction);
   const cv::Mat static_mask = cv::imread((folder / "left_out" / "static_mask.png").string(), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(static_mask.empty());
   EXPECT_EQ(cv::countNonZero(static_mask & strokes), cv::countNonZero(strokes));
@@ -1353,7 +1406,7 @@ TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   RunResult result;
   result.sequence = "display";
   result.status = "ok";
-  result.static_fraction = left_out.static_fraction;
+  result.input.static_fraction = left_out.input.static_fraction;
   result.run_folder = (folder / "left_out").string();
   WriteReport({result}, {}, {}, folder / "report");
   std::ifstream page(folder / "report" / "index.html");
@@ -1365,7 +1418,7 @@ TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   SystemOptions kept = TrackingExperiment();
   kept.frontend.masks.static_frames = 0;
   const RunSummary tracked = RunSequence(folder / "sequence", kept, folder / "tracked");
-  EXPECT_EQ(tracked.static_fraction, 0);
+  EXPECT_EQ(tracked.input.static_fraction, 0);
   EXPECT_GE(points_on_display(folder / "tracked", 39), 5);
   EXPECT_GT(tracked.rmse_mm, 1.1 * left_out.rmse_mm);
 }
@@ -1382,7 +1435,7 @@ TEST_F(RunSequenceTest, AStillViewIsNotLeftOut) {
   SystemOptions checked = TrackingExperiment();
   checked.frontend.masks.static_min_seconds = 1;
   const RunSummary still = RunSequence(sequence, checked, folder / "run");
-  EXPECT_EQ(still.static_fraction, 0);
+  EXPECT_EQ(still.input.static_fraction, 0);
   EXPECT_FALSE(fs::exists(folder / "run" / "static_mask.png"));
   EXPECT_EQ(still.frames_tracked, 40);
   EXPECT_EQ(CountLines(folder / "run" / "run.log", "a still view rather than a display"), 1);
@@ -1401,7 +1454,7 @@ TEST_F(RunSequenceTest, AShortRunIsCheckedForADisplayOverItsWholeSequence) {
   first_frames.run.last_frame = 12;
   const RunSummary run = RunSequence(sequence, first_frames, folder / "run");
   EXPECT_EQ(run.frames_total, 12);
-  EXPECT_GT(run.static_fraction, 0.02);
+  EXPECT_GT(run.input.static_fraction, 0.02);
   const cv::Mat static_mask = cv::imread((folder / "run" / "static_mask.png").string(), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(static_mask.empty());
   EXPECT_EQ(cv::countNonZero(static_mask & strokes), cv::countNonZero(strokes));
@@ -1415,13 +1468,13 @@ TEST(RunSequenceShortSequence, IsNotCheckedForDisplays) {
   fs::remove_all(folder);
   SimulateSmall("sim-2", 12, 160, 120, folder / "sequence");
   const RunSummary short_run = RunSequence(folder / "sequence", TrackingExperiment(), folder / "run");
-  EXPECT_EQ(short_run.static_fraction, 0);
+  EXPECT_EQ(short_run.input.static_fraction, 0);
   EXPECT_EQ(short_run.frames_tracked, 12);
   EXPECT_EQ(CountLines(folder / "run" / "run.log", "the sequence spans 0.4 s, under static_min_seconds"), 1);
   SystemOptions unguarded = TrackingExperiment();
   unguarded.frontend.masks.static_min_seconds = 0;
   const RunSummary checked = RunSequence(folder / "sequence", unguarded, folder / "checked");
-  EXPECT_GT(checked.static_fraction, 0.3) << "the check would mistake this tissue for a display";
+  EXPECT_GT(checked.input.static_fraction, 0.3) << "the check would mistake this tissue for a display";
   EXPECT_LT(checked.frames_tracked, 12);
   fs::remove_all(folder);
 }
@@ -1447,7 +1500,7 @@ TEST_F(RunSequenceTest, FramesMissingFromTheRecordingAreNotedAsAJump) {
 
   const RunSummary cut = RunSequence(sequence, TrackingExperiment(), folder / "run");
   EXPECT_EQ(cut.frames_tracked, kFrames - kCut);
-  EXPECT_EQ(cut.view_jumps, 1);
+  EXPECT_EQ(cut.input.view_jumps, 1);
   EXPECT_EQ(ReadJsonFile(folder / "run" / "summary.json").at("view_jumps"), 1);
   const auto metrics = ReadCsv(folder / "run" / "metrics.csv");
   ASSERT_EQ(metrics.size(), static_cast<size_t>(kFrames - kCut));
@@ -1456,7 +1509,7 @@ TEST_F(RunSequenceTest, FramesMissingFromTheRecordingAreNotedAsAJump) {
   EXPECT_NE(DescribeSummary(cut).find("1 jump of the view"), std::string::npos) << DescribeSummary(cut);
   SystemOptions unnoted = TrackingExperiment();
   unnoted.tracking.jump_flow_ratio = 0;
-  EXPECT_EQ(RunSequence(sequence, unnoted, folder / "unnoted").view_jumps, 0);
+  EXPECT_EQ(RunSequence(sequence, unnoted, folder / "unnoted").input.view_jumps, 0);
 }
 
 // An instrument over most of the view hides more than half of the map's tracks, but those it
@@ -1468,9 +1521,9 @@ TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
 
   const RunSummary tracked = RunSequence(folder / "sequence", TrackingExperiment(), folder / "tracked");
   EXPECT_EQ(tracked.Status(), "ok");
-  EXPECT_EQ(tracked.frames_dropout, 0);
+  EXPECT_EQ(tracked.input.frames_dropout, 0);
   EXPECT_EQ(tracked.frames_tracked, 40);
-  EXPECT_EQ(tracked.sudden_occlusions, 1);  // counted once, on the frame it came
+  EXPECT_EQ(tracked.input.sudden_occlusions, 1);  // counted once, on the frame it came
   EXPECT_EQ(ReadJsonFile(folder / "tracked" / "summary.json").at("sudden_occlusions"), 1);
   const auto metrics = ReadCsv(folder / "tracked" / "metrics.csv");
   ASSERT_EQ(metrics.size(), 40u);
@@ -1484,8 +1537,8 @@ TEST_F(RunSequenceTest, AnInstrumentOverMostOfTheViewIsNotADropout) {
   SystemOptions strict = TrackingExperiment();
   strict.tracking.dropout_min_match_ssim = 1;
   const RunSummary skipped = RunSequence(folder / "sequence", strict, folder / "skipped");
-  EXPECT_EQ(skipped.frames_dropout, 3);
-  EXPECT_EQ(skipped.sudden_occlusions, 0);
+  EXPECT_EQ(skipped.input.frames_dropout, 3);
+  EXPECT_EQ(skipped.input.sudden_occlusions, 0);
 }
 
 // An instrument hides most of the view for ten frames while the tissue under it goes on
@@ -1525,7 +1578,7 @@ TEST_F(RunSequenceTest, PointsAnInstrumentSlidingInHidAreFoundAgainToo) {
     SystemOptions options = TrackingExperiment();
     options.tracking.hidden_recent_frames = recent_frames;
     const auto [count, summary] = FoundAgain(folder, name, options, gone - steps, gone + 3);
-    EXPECT_EQ(summary.sudden_occlusions, 0) << name;
+    EXPECT_EQ(summary.input.sudden_occlusions, 0) << name;
     return count;
   };
   const int by_gate = found_again("gate", 0);
@@ -1569,13 +1622,13 @@ TEST(MonocularRun, AShortImageDropoutKeepsTheMap) {
   EXPECT_LT(summary.init_frame, 25);
   EXPECT_EQ(summary.Status(), "ok");
   EXPECT_EQ(summary.maps, 1);
-  EXPECT_EQ(summary.frames_dropout, 2);
+  EXPECT_EQ(summary.input.frames_dropout, 2);
   EXPECT_EQ(summary.frames_tracked, 40 - summary.init_frame - 2);
   SystemOptions reference;
   reference.tracking.max_dropout_frames = 0;
   const RunSummary restarted = RunSequence(folder / "sequence", reference, folder / "reference");
   EXPECT_EQ(restarted.maps, 2);  // lost on the first blank frame, a new map from the images after
-  EXPECT_EQ(restarted.frames_dropout, 0);
+  EXPECT_EQ(restarted.input.frames_dropout, 0);
   fs::remove_all(folder);
 }
 

@@ -37,14 +37,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->frames_total = json.value("frames_total", 0);
   // Results written before the field existed always had ground truth for every tracked frame.
   result->frames_evaluated = json.value("frames_evaluated", result->frames_tracked);
-  result->frames_unreadable = json.value("frames_unreadable", 0);
-  // Results written before the field existed cannot tell: their unreadable frames count as lost.
-  result->frames_unreadable_after_init = json.value("frames_unreadable_after_init", 0);
-  result->frames_groundtruth_unreadable = json.value("frames_groundtruth_unreadable", 0);
-  result->frames_dropout = json.value("frames_dropout", 0);
-  result->sudden_occlusions = json.value("sudden_occlusions", 0);
-  result->view_jumps = json.value("view_jumps", 0);
-  result->static_fraction = json.value("static_fraction", 0.0);
+  result->input = json.get<InputEffects>();
   result->rmse_mm = json.value("rmse_mm", 0.0);
   result->rmse_median_mm = json.value("rmse_median_mm", 0.0);
   result->rmse_flat_mm = NumberOr(json, "rmse_flat_mm", -1.0);
@@ -197,7 +190,7 @@ std::string RmseChangeCounts::ToString() const {
 
 std::string RunStatus(const RunResult& figures) {
   if (figures.init_frame < 0) return "not_initialised";
-  const int input_not_tracked = figures.frames_dropout + figures.frames_unreadable_after_init;
+  const int input_not_tracked = figures.input.frames_dropout + figures.input.frames_unreadable_after_init;
   const bool every_frame = figures.init_frame + figures.frames_tracked + input_not_tracked >= figures.frames_total;
   return every_frame && figures.stop_reason.empty() ? "ok" : "lost";
 }
@@ -207,9 +200,7 @@ std::string StopText(const RunResult& result) {
 }
 
 std::vector<std::string> RunNotes(const RunResult& result) {
-  std::vector<std::string> notes = InputNotes(result.frames_unreadable, result.frames_groundtruth_unreadable,
-                                              result.frames_dropout, result.sudden_occlusions, result.view_jumps,
-                                              result.static_fraction);
+  std::vector<std::string> notes = result.input.Notes();
   const std::string stop = StopText(result);
   if (!stop.empty()) notes.insert(notes.begin(), stop);
   return notes;
@@ -217,7 +208,8 @@ std::vector<std::string> RunNotes(const RunResult& result) {
 
 std::string RmseCell(const RunResult& result, double rmse_mm) {
   if (result.evaluated()) return FormatFixed(rmse_mm, 3);
-  return result.frames_tracked > 0 ? "no GT" : "-";  // with no frame tracked there was nothing to score
+  if (result.frames_tracked == 0) return "-";  // nothing to score
+  return result.input.frames_sparse_groundtruth > 0 ? "sparse GT" : "no GT";
 }
 
 std::string RecordedRmseCell(const RunResult& result, double rmse_mm) {
@@ -298,28 +290,24 @@ std::string RecordedField(const std::optional<double>& value) {
 Json ToJson(const std::vector<RunResult>& results) {
   Json rows = Json::array();
   for (const RunResult& r : results) {
-    rows.push_back({{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
-                    {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
-                    {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated},
-                    {"frames_unreadable", r.frames_unreadable},
-                    {"frames_unreadable_after_init", r.frames_unreadable_after_init},
-                    {"frames_groundtruth_unreadable", r.frames_groundtruth_unreadable},
-                    {"frames_dropout", r.frames_dropout}, {"sudden_occlusions", r.sudden_occlusions},
-                    {"view_jumps", r.view_jumps},
-                    {"static_fraction", r.static_fraction}, {"rmse_mm", r.rmse_mm},
-                    {"rmse_median_mm", r.rmse_median_mm},
-                    {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
-                    {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
-                    {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
-                    {"ate_rmse_mm", RecordedNumber(r.ate_mm)}, {"fps", r.fps},
-                    {"peak_memory_mb", RecordedNumber(r.peak_memory_mb)},
-                    {"births_evaluated", r.births_evaluated},
-                    {"birth_log_error_mean", RecordedNumber(r.birth_log_error_mean)},
-                    {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)}, {"run_folder", r.run_folder},
-                    {"revision", r.revision.empty() ? Json() : Json(r.revision)},
-                    {"code", r.code.empty() ? Json() : Json(r.code)},
-                    {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
-                    {"stop_reason", r.stop_reason.empty() ? Json() : Json(r.stop_reason)}});
+    Json row{{"sequence", r.sequence}, {"label", r.label}, {"point", r.point}, {"status", r.status},
+             {"error", r.error}, {"init_frame", r.init_frame}, {"frames_tracked", r.frames_tracked},
+             {"frames_total", r.frames_total}, {"frames_evaluated", r.frames_evaluated}, {"rmse_mm", r.rmse_mm},
+             {"rmse_median_mm", r.rmse_median_mm},
+             {"rmse_flat_mm", RecordedNumber(r.rmse_flat_mm)},
+             {"rmse_map_scale_mm", RecordedNumber(r.rmse_map_scale_mm)},
+             {"rmse_median_scale_mm", RecordedNumber(r.rmse_median_scale_mm)},
+             {"ate_rmse_mm", RecordedNumber(r.ate_mm)}, {"fps", r.fps},
+             {"peak_memory_mb", RecordedNumber(r.peak_memory_mb)},
+             {"births_evaluated", r.births_evaluated},
+             {"birth_log_error_mean", RecordedNumber(r.birth_log_error_mean)},
+             {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)}, {"run_folder", r.run_folder},
+             {"revision", r.revision.empty() ? Json() : Json(r.revision)},
+             {"code", r.code.empty() ? Json() : Json(r.code)},
+             {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
+             {"stop_reason", r.stop_reason.empty() ? Json() : Json(r.stop_reason)}};
+    row.update(Json(r.input));
+    rows.push_back(std::move(row));
   }
   return {{"results", rows}};
 }
@@ -353,15 +341,17 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
-         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_dropout,"
-         "sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,rmse_map_scale_mm,"
-         "rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
+         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
+         "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
+         "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
          "birth_log_error_median,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
-        << r.frames_unreadable << ',' << r.frames_unreadable_after_init << ',' << r.frames_groundtruth_unreadable << ','
-        << r.frames_dropout << ',' << r.sudden_occlusions << ',' << r.view_jumps << ',' << r.static_fraction << ','
+        << r.input.frames_unreadable << ',' << r.input.frames_unreadable_after_init << ','
+        << r.input.frames_groundtruth_unreadable << ',' << r.input.frames_sparse_groundtruth << ','
+        << r.input.frames_dropout << ',' << r.input.sudden_occlusions << ',' << r.input.view_jumps << ','
+        << r.input.static_fraction << ','
         << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/system/run_files.h"
 #include "nrslam/util/json_options.h"
 
 namespace nrslam {
@@ -21,13 +22,7 @@ struct RunResult {
   std::string error;                // why it failed
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
-  int frames_unreadable = 0;              // frames lost because their image could not be read
-  int frames_unreadable_after_init = 0;   // of them, those after the first map started
-  int frames_groundtruth_unreadable = 0;  // tracked frames not scored: their ground-truth file was unreadable
-  int frames_dropout = 0;                 // frames lost as image dropouts, the map kept
-  int sudden_occlusions = 0;              // tracked frames that lost most of the view at once (RunSummary)
-  int view_jumps = 0;                     // tracked frames whose view jumped (RunSummary)
-  double static_fraction = 0;             // share of the image left out as never changing (RunSummary)
+  InputEffects input;               // what damaged or unusual input did to the run (RunSummary)
   double rmse_mm = 0, rmse_median_mm = 0, fps = 0;
   double peak_memory_mb = -1;       // the run process's peak resident memory; negative: not recorded
   double ate_mm = -1;               // similarity-aligned trajectory error; negative: none
@@ -97,7 +92,7 @@ std::string StopText(const RunResult& result);
 // unreadable input and image dropouts cost it. Empty for a run that lost nothing.
 std::vector<std::string> RunNotes(const RunResult& result);
 // An RMSE figure of `result` as a table shows it: "no GT" when frames were tracked but none had
-// ground truth, "-" when no frame was tracked.
+// ground truth, "sparse GT" when some had but too sparse to score, "-" when no frame was tracked.
 std::string RmseCell(const RunResult& result, double rmse_mm);
 // An RMSE that older results may lack (the flat map's, the map-scale one) as a table shows
 // it: "-" when not recorded (negative).

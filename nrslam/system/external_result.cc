@@ -264,8 +264,9 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
         depth_mm = reader.TryReadDepthMm(frame, &depth_problem);
         if (depth_problem.empty()) {
           frame_evaluation = EvaluateFrame(depth_points, depth_mm, evaluation);
+          if (frame_evaluation.points_used < evaluation.min_points) ++summary.input.frames_sparse_groundtruth;
         } else {
-          ++summary.frames_groundtruth_unreadable;
+          ++summary.input.frames_groundtruth_unreadable;
         }
       }
       if (ids_name_points) {

@@ -32,6 +32,13 @@ std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_un
   return text.empty() ? text : text + "; metrics.csv names the files";
 }
 
+std::string SparseGroundTruthText(int frames_sparse_groundtruth) {
+  if (frames_sparse_groundtruth == 0) return "";
+  return std::to_string(frames_sparse_groundtruth) +
+         (frames_sparse_groundtruth == 1 ? " tracked frame" : " tracked frames") +
+         " not scored: too few of their points on valid ground truth (under evaluation.min_points)";
+}
+
 std::string DropoutText(int frames_dropout) {
   if (frames_dropout == 0) return "";
   return std::to_string(frames_dropout) +
@@ -61,11 +68,11 @@ std::string StaticRegionText(double static_fraction) {
   return text.str();
 }
 
-std::vector<std::string> InputNotes(int frames_unreadable, int frames_groundtruth_unreadable, int frames_dropout,
-                                    int sudden_occlusions, int view_jumps, double static_fraction) {
+std::vector<std::string> InputEffects::Notes() const {
   std::vector<std::string> notes;
   for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
-                           DropoutText(frames_dropout), OcclusionText(sudden_occlusions), ViewJumpText(view_jumps),
+                           SparseGroundTruthText(frames_sparse_groundtruth), DropoutText(frames_dropout),
+                           OcclusionText(sudden_occlusions), ViewJumpText(view_jumps),
                            StaticRegionText(static_fraction)}) {
     if (!note.empty()) notes.push_back(std::move(note));
   }
@@ -99,6 +106,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.frames_evaluated > 0) {
     text << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
          << summary.rmse_flat_mm << " mm; one scale per map " << summary.rmse_map_scale_mm << " mm)  ";
+  } else if (summary.input.frames_sparse_groundtruth > 0) {
+    text << "no RMSE: the ground truth is too sparse to score any frame  ";
   } else {
     text << "no ground truth, no RMSE  ";
   }
@@ -111,9 +120,7 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
-  for (const std::string& note : InputNotes(summary.frames_unreadable, summary.frames_groundtruth_unreadable,
-                                            summary.frames_dropout, summary.sudden_occlusions, summary.view_jumps,
-                                            summary.static_fraction)) {
+  for (const std::string& note : summary.input.Notes()) {
     text << '\n' << note;
   }
   return text.str();
@@ -193,13 +200,6 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"frames_total", summary.frames_total},
                       {"frames_lost", summary.frames_lost},
                       {"frames_evaluated", summary.frames_evaluated},
-                      {"frames_unreadable", summary.frames_unreadable},
-                      {"frames_unreadable_after_init", summary.frames_unreadable_after_init},
-                      {"frames_groundtruth_unreadable", summary.frames_groundtruth_unreadable},
-                      {"frames_dropout", summary.frames_dropout},
-                      {"sudden_occlusions", summary.sudden_occlusions},
-                      {"view_jumps", summary.view_jumps},
-                      {"static_fraction", summary.static_fraction},
                       {"init_frame", summary.init_frame},
                       {"fps", summary.fps},
                       {"peak_memory_mb", summary.peak_memory_mb > 0 ? nlohmann::json(summary.peak_memory_mb) : nlohmann::json()},
@@ -218,6 +218,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"birth_log_error_mean", summary.births.mean ? nlohmann::json(*summary.births.mean) : nlohmann::json()},
                       {"birth_log_error_median", summary.births.median ? nlohmann::json(*summary.births.median) : nlohmann::json()},
                       {"map_points", summary.map_points}};
+  json.update(nlohmann::json(summary.input));
   json.update(provenance);
   json["status"] = summary.Status();
   json["stop_frame"] = summary.stop_frame >= 0 ? nlohmann::json(summary.stop_frame) : nlohmann::json();

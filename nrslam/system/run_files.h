@@ -24,22 +24,19 @@ inline constexpr const char* kMetricsCsvHeader =
     "deformable_candidates,new_points,points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,"
     "ms_dba,ms_triangulation,ms_total,ms_joint_solve,ms_linear_solve,note";
 
-struct RunSummary {
-  double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
-  double rmse_flat_mm = 0;  // the same points all at one depth (eval/depth_evaluation.h)
-  // The same frames at one scale per map, and at each frame's median ratio (OtherAlignments).
-  double rmse_map_scale_mm = 0, rmse_median_scale_mm = 0;
-  int frames_tracked = 0;  // frames with a pose after initialisation (the paper's "# Fr.")
-  int frames_total = 0;
-  int frames_lost = 0;
-  int init_frame = -1;
-  int frames_evaluated = 0;
+// What the input did to a run, as the runner counts it in summary.json and the batch reads it
+// back into results.json: files that could not be read, frames skipped or noted, ground truth
+// too sparse to score, and the part of the image left out as never changing.
+struct InputEffects {
   // Frames lost because their colour image or mask could not be read (the run goes on), and
   // tracked frames left unscored because their ground-truth depth file could not be read.
   int frames_unreadable = 0, frames_groundtruth_unreadable = 0;
   // Of frames_unreadable, those after the first map started: the batch's status tells them
   // apart from frames the system failed to track (batch/results.h, RunStatus).
   int frames_unreadable_after_init = 0;
+  // Tracked frames whose ground truth was read but valid under fewer than the evaluator's
+  // min_points of their points (depth missing over most of the view): not scored.
+  int frames_sparse_groundtruth = 0;
   // Frames lost as image dropouts: skipped with the map kept (TrackingOptions::max_dropout_frames).
   int frames_dropout = 0;
   // Frames tracked although most of the view was hidden at once (FrameResult::sudden_occlusion):
@@ -51,6 +48,28 @@ struct RunSummary {
   // The share of the image left out because it never changed over the sequence (an on-screen
   // display, an unmasked black border; frontend FindStaticRegions, margin included).
   double static_fraction = 0;
+  // One note each, those that apply, in the order the runner and nrslam_eval print them:
+  // unreadable files, sparse ground truth, image dropouts, sudden occlusions, jumps of the view,
+  // static regions.
+  std::vector<std::string> Notes() const;
+};
+// Under the same flat keys in summary.json and in a results.json row; a key missing (results
+// written before it existed) reads as none.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InputEffects, frames_unreadable, frames_groundtruth_unreadable,
+                                                frames_unreadable_after_init, frames_sparse_groundtruth,
+                                                frames_dropout, sudden_occlusions, view_jumps, static_fraction)
+
+struct RunSummary {
+  double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
+  double rmse_flat_mm = 0;  // the same points all at one depth (eval/depth_evaluation.h)
+  // The same frames at one scale per map, and at each frame's median ratio (OtherAlignments).
+  double rmse_map_scale_mm = 0, rmse_median_scale_mm = 0;
+  int frames_tracked = 0;  // frames with a pose after initialisation (the paper's "# Fr.")
+  int frames_total = 0;
+  int frames_lost = 0;
+  int init_frame = -1;
+  int frames_evaluated = 0;
+  InputEffects input;  // what damaged or unusual input did to the run
   double fps = 0;          // frames processed per second of wall time (reading included)
   // The process's peak resident memory when the run ended (MB; util/memory_usage.h): the run's
   // own under nrslam_run and nrslam_eval, which give each sequence its own process. 0: not measured.
@@ -81,6 +100,10 @@ std::string DescribeStop(int init_frame, int stop_frame, const std::string& reas
 // on 2 tracked frames (not scored); metrics.csv names the files"; "" when nothing.
 std::string UnreadableInputText(int frames_unreadable, int frames_groundtruth_unreadable);
 
+// "3 tracked frames not scored: too few of their points on valid ground truth (under
+// evaluation.min_points)"; "" when none.
+std::string SparseGroundTruthText(int frames_sparse_groundtruth);
+
 // "2 frames skipped as image dropouts (lost; the map kept)"; "" when none.
 std::string DropoutText(int frames_dropout);
 
@@ -95,12 +118,6 @@ std::string ViewJumpText(int view_jumps);
 // "9.9 % of the image never changed (an on-screen display, a black border or background) and
 // was left out (static_mask.png)"; "" when none.
 std::string StaticRegionText(double static_fraction);
-
-// What the input did to a run, one note each, those that apply, in the order the runner and
-// nrslam_eval print them: unreadable files, image dropouts, sudden occlusions, jumps of the view,
-// static regions.
-std::vector<std::string> InputNotes(int frames_unreadable, int frames_groundtruth_unreadable, int frames_dropout,
-                                    int sudden_occlusions, int view_jumps, double static_fraction);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked

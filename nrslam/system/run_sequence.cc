@@ -169,6 +169,14 @@ class FrameIo {
   std::future<void> write_;
 };
 
+// Why a tracked frame whose ground truth was read has no score: "not scored: 3 of its 40 points
+// on valid ground truth (evaluation.min_points = 5)".
+std::string SparseGroundTruthNote(const FrameEvaluation& evaluation, const EvaluationOptions& options) {
+  const int points = evaluation.points_used + evaluation.points_without_groundtruth;
+  return "not scored: " + std::to_string(evaluation.points_used) + " of its " + std::to_string(points) +
+         " points on valid ground truth (evaluation.min_points = " + std::to_string(options.min_points) + ")";
+}
+
 }  // namespace
 
 RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, const fs::path& out,
@@ -224,10 +232,10 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         << " % of the image never changed: a still view rather than a display, so none of it was left out\n";
     static_regions.release();
   } else if (static_fraction > 0) {
-    summary.static_fraction = static_fraction;
+    summary.input.static_fraction = static_fraction;
     const fs::path file = out / "static_mask.png";
     if (!cv::imwrite(file.string(), static_regions)) throw Error("cannot write " + file.string());
-    log << StaticRegionText(summary.static_fraction) << '\n';
+    log << StaticRegionText(summary.input.static_fraction) << '\n';
   }
   FrameIo io(reader, first, last, std::move(static_regions));
   for (int frame = first; frame < last; ++frame) {
@@ -245,13 +253,13 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask, io.PeekNextBgr());
         if (result.state == TrackingState::kLost) {
-          summary.frames_dropout += result.dropout;
+          summary.input.frames_dropout += result.dropout;
           log << "frame " << frame << ": lost (" << result.note << ")\n";
         } else if (!result.note.empty()) {
           log << "frame " << frame << ": " << result.note << '\n';
         }
-        summary.sudden_occlusions += result.sudden_occlusion;
-        summary.view_jumps += result.view_jump;
+        summary.input.sudden_occlusions += result.sudden_occlusion;
+        summary.input.view_jumps += result.view_jump;
         if (result.state == TrackingState::kTracking && options.run.mapping) {
           mapping = mapper.Process(result, bgr, mask, &tracker);
           result.cam_from_world = tracker.pose();  // the DBA may have refined it
@@ -301,8 +309,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     } catch (const Error& e) {
       result.state = TrackingState::kLost;  // an unreadable frame: recorded, and the run goes on
       result.note = e.what();
-      ++summary.frames_unreadable;
-      if (summary.init_frame >= 0) ++summary.frames_unreadable_after_init;
+      ++summary.input.frames_unreadable;
+      if (summary.init_frame >= 0) ++summary.input.frames_unreadable_after_init;
       log << "frame " << frame << ": " << e.what() << '\n';
     }
 
@@ -315,7 +323,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     const bool tracked = result.state == TrackingState::kTracking;
     if (tracked && !depth_problem.empty()) {
       // Tracked as if it were whole: only its score is missing, and the run says so.
-      ++summary.frames_groundtruth_unreadable;
+      ++summary.input.frames_groundtruth_unreadable;
       const std::string not_scored = "not scored: " + depth_problem;
       log << "frame " << frame << ": " << not_scored << '\n';
       result.note = result.note.empty() ? not_scored : not_scored + "; " + result.note;
@@ -342,6 +350,12 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         evaluation.map = maps;
+        if (evaluation.points_used < options.evaluation.min_points) {
+          ++summary.input.frames_sparse_groundtruth;
+          const std::string not_scored = SparseGroundTruthNote(evaluation, options.evaluation);
+          log << "frame " << frame << ": " << not_scored << '\n';
+          result.note = result.note.empty() ? not_scored : not_scored + "; " + result.note;
+        }
       }
       // Every tracked frame, with ground truth or not: a point is born once, where it first appears.
       births.AddFrame(ids, depth_points, depth_mm, evaluation, frame == map_start_frame);
