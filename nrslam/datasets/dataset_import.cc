@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -244,6 +245,13 @@ FrameSource C3vd(const ImportOptions& options) {
   return source;
 }
 
+// FFmpeg, where OpenCV has it, rather than every backend in turn: the others print their own
+// failures (GStreamer an assertion and a stack of warnings) above ours for a file none can open.
+cv::VideoCapture OpenVideo(const fs::path& file) {
+  const int backend = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
+  return cv::VideoCapture(file.string(), backend);
+}
+
 // The frames of an image folder (sorted by name) or a video file: their count and a reader,
 // which for a video only goes forward (frames skipped over are grabbed, not decoded).
 struct FrameStream {
@@ -262,11 +270,11 @@ FrameStream OpenFrames(const ImportOptions& options, const fs::path& input) {
   }
   // A video: count the frames first (grab without decoding), then decode them in order.
   if (!fs::exists(input)) Fail(options, input.string() + " does not exist");
-  cv::VideoCapture counter(input.string());
+  cv::VideoCapture counter = OpenVideo(input);
   if (!counter.isOpened()) Fail(options, "cannot open " + input.string() + " as an image folder or a video");
   while (counter.grab()) ++stream.count;
   if (stream.count == 0) Fail(options, "the video " + input.string() + " has no frames");
-  auto video = std::make_shared<cv::VideoCapture>(input.string());
+  auto video = std::make_shared<cv::VideoCapture>(OpenVideo(input));
   auto next = std::make_shared<int>(0);  // the frame the video decodes next
   stream.read = [&options, video, next, input](int i) {
     if (i < *next) {
