@@ -13,6 +13,8 @@ void MaskOptions::Check() const {
   CheckOption(static_min_area_px >= 0 && static_margin_px >= 0, "masks", "static sizes must be >= 0");
   CheckOption(static_min_edge >= 0, "masks", "static_min_edge must be >= 0");
   CheckOption(static_min_seconds >= 0, "masks", "static_min_seconds must be >= 0");
+  CheckOption(static_window_seconds >= static_min_seconds && static_window_seconds > 0, "masks",
+              "static_window_seconds must be > 0 and >= static_min_seconds");
   CheckOption(static_max_fraction >= 0 && static_max_fraction <= 1, "masks", "static_max_fraction must be in [0, 1]");
 }
 

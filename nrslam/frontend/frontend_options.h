@@ -12,8 +12,9 @@ struct MaskOptions {
   int bright_margin_px = 6;       // highlights also invalidate this many px around them
   int erosion_px = 5;             // the combined valid area is eroded by this, px
   // Regions that never change over a sequence (an on-screen display, a black border without a
-  // mask): found once from this many frames spread over the sequence and left out, since a
-  // corner there would be tracked as a point that moves with the camera. 0 = off.
+  // mask): found from this many frames spread over each window of the sequence and left out of
+  // that window's frames, since a corner there would be tracked as a point that moves with the
+  // camera. 0 = off.
   int static_frames = 24;
   int static_max_change = 4;      // a static pixel is within this many grey levels of its median in 9 of 10 frames
   int static_min_area_px = 64;    // smaller static patches are ignored (a few px of flat tissue)
@@ -26,6 +27,10 @@ struct MaskOptions {
   // past stays put as a display does (intact renderings at 160x120 to 640x480 lost up to 84 %
   // of the image to the check within 2.5 s, none from 3 s on).
   double static_min_seconds = 3.5;
+  // s: a longer sequence is looked at in windows this long, each half a window after the last,
+  // so that a display shown for a while only is found (in the windows it fills, at least 9 of
+  // 10 of their frames). At least static_min_seconds.
+  double static_window_seconds = 8;
   // The fewest frames that can tell a static region: one in ten may stray (a dropout, a flash).
   static constexpr int kMinStaticFrames = 10;
   void Check() const;
@@ -88,7 +93,8 @@ struct FrontendOptions {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MaskOptions, border_px, bright_threshold, bright_margin_px, erosion_px,
                                                 static_frames, static_max_change, static_min_area_px, static_min_edge,
-                                                static_margin_px, static_max_fraction, static_min_seconds)
+                                                static_margin_px, static_max_fraction, static_min_seconds,
+                                                static_window_seconds)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureOptions, min_eigenvalue, nms_radius_px, exclusion_radius_px,
                                                 max_features)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(KltOptions, window_px, levels, max_iterations, epsilon_px,

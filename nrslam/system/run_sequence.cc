@@ -18,6 +18,7 @@
 #include "nrslam/io/tum.h"
 #include "nrslam/mapping/mapper.h"
 #include "nrslam/mapping/monocular_initialiser.h"
+#include "nrslam/system/static_regions.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/concurrent.h"
 #include "nrslam/util/csv.h"
@@ -60,50 +61,17 @@ struct FrameImages {
   std::string depth_problem;  // why depth_mm is empty although the sequence has depth
 };
 
-// The sequence's static regions (FindStaticRegions), from frames spread evenly over all of it,
-// whatever part a run takes: the longer the span, the surer the verdict. Empty when the option is
-// off, when the sequence is too short to tell (said in `log`), when fewer frames than that needs
-// can be read (an unreadable one is reported when a run reaches it), or when there are none.
-cv::Mat StaticRegionsOfSequence(const SequenceReader& reader, const MaskOptions& options, std::ostream& log) {
-  if (options.static_frames == 0) return {};
-  const int span = reader.frame_count();
-  const double seconds = span / reader.info().fps;
-  if (seconds < options.static_min_seconds) {
-    log << "not looked for regions that never change (an on-screen display): the sequence spans "
-        << FormatFixed(seconds, 1) << " s, under static_min_seconds = " << FormatFixed(options.static_min_seconds, 1)
-        << " s\n";
-    return {};
-  }
-  const int samples = std::min(options.static_frames, span);
-  if (samples < MaskOptions::kMinStaticFrames) return {};
-  // Decoding the frames takes most of the time: each core decodes every other one.
-  std::vector<cv::Mat> greys(static_cast<size_t>(samples));
-  const auto read_every_other = [&](int parity) {
-    for (int k = parity; k < samples; k += 2) {
-      const int frame = static_cast<int>(static_cast<int64_t>(k) * (span - 1) / (samples - 1));
-      try {
-        greys[static_cast<size_t>(k)] = ToGrey(reader.ReadRgb(frame));
-      } catch (const Error&) {
-      }
-    }
-  };
-  RunConcurrently([&] { read_every_other(0); }, [&] { read_every_other(1); });
-  const auto unread = [](const cv::Mat& grey) { return grey.empty(); };
-  greys.erase(std::remove_if(greys.begin(), greys.end(), unread), greys.end());
-  if (greys.size() < static_cast<size_t>(MaskOptions::kMinStaticFrames)) return {};
-  return FindStaticRegions(greys, reader.fixed_mask(), options);
-}
-
 // An unreadable colour image or mask makes the frame unusable (thrown); an unreadable depth map
-// only matters where depth is used, so it is reported beside the frame instead. `static_regions`
-// (may be empty) are left out of the frame's mask.
-FrameImages ReadFrame(const SequenceReader& reader, int frame, const cv::Mat& static_regions) {
+// only matters where depth is used, so it is reported beside the frame instead. The sequence's
+// static regions on this frame are left out of its mask.
+FrameImages ReadFrame(const SequenceReader& reader, int frame, const StaticRegions& static_regions) {
   FrameImages images;
   images.bgr = reader.ReadRgb(frame);
   images.mask = reader.ReadMask(frame);
-  if (!static_regions.empty()) {
-    if (images.mask.empty()) images.mask = cv::Mat(static_regions.size(), CV_8UC1, cv::Scalar(255));
-    images.mask.setTo(0, static_regions);
+  const cv::Mat& left_out = static_regions.At(frame);
+  if (!left_out.empty()) {
+    if (images.mask.empty()) images.mask = cv::Mat(left_out.size(), CV_8UC1, cv::Scalar(255));
+    images.mask.setTo(0, left_out);
   }
   if (reader.has_depth()) images.depth_mm = reader.TryReadDepthMm(frame, &images.depth_problem);
   return images;
@@ -116,7 +84,7 @@ FrameImages ReadFrame(const SequenceReader& reader, int frame, const cv::Mat& st
 // only the wall-clock time changes.
 class FrameIo {
  public:
-  FrameIo(const SequenceReader& reader, int first, int last, cv::Mat static_regions)
+  FrameIo(const SequenceReader& reader, int first, int last, StaticRegions static_regions)
       : reader_(reader), static_regions_(std::move(static_regions)), next_(first), last_(last) {
     Prefetch();
     Prefetch();
@@ -160,7 +128,7 @@ class FrameIo {
     }
   }
   const SequenceReader& reader_;
-  const cv::Mat static_regions_;
+  const StaticRegions static_regions_;
   int next_;  // the next frame to prefetch
   int last_;
   // Futures of std::async wait for their thread when the last one sharing it goes, so a run
@@ -224,17 +192,11 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
-  cv::Mat static_regions = StaticRegionsOfSequence(reader, options.frontend.masks, log);
-  const double static_fraction =
-      static_regions.empty() ? 0 : cv::countNonZero(static_regions) / static_cast<double>(static_regions.total());
-  if (static_fraction > options.frontend.masks.static_max_fraction) {
-    log << std::lround(100 * static_fraction)
-        << " % of the image never changed: a still view rather than a display, so none of it was left out\n";
-    static_regions.release();
-  } else if (static_fraction > 0) {
-    summary.input.static_fraction = static_fraction;
+  StaticRegions static_regions = StaticRegions::OfSequence(reader, options.frontend.masks, log);
+  summary.input.static_fraction = static_regions.Fraction();
+  if (summary.input.static_fraction > 0) {
     const fs::path file = out / "static_mask.png";
-    if (!cv::imwrite(file.string(), static_regions)) throw Error("cannot write " + file.string());
+    if (!cv::imwrite(file.string(), static_regions.Union())) throw Error("cannot write " + file.string());
     log << StaticRegionText(summary.input.static_fraction) << '\n';
   }
   FrameIo io(reader, first, last, std::move(static_regions));

@@ -1,0 +1,124 @@
+#include "nrslam/system/static_regions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <set>
+
+#include "nrslam/frontend/masks.h"
+#include "nrslam/util/concurrent.h"
+#include "nrslam/util/error.h"
+#include "nrslam/util/text_table.h"
+
+namespace nrslam {
+namespace {
+
+// The grey images of `samples` frames spread evenly over [first, last), those that can be read.
+// Decoding takes most of the check's time: each core decodes every other frame.
+std::vector<cv::Mat> ReadSpreadGreys(const SequenceReader& reader, int first, int last, int samples) {
+  std::vector<cv::Mat> greys(static_cast<size_t>(samples));
+  const int span = last - first;
+  const auto read_every_other = [&](int parity) {
+    for (int k = parity; k < samples; k += 2) {
+      const int frame = first + static_cast<int>(static_cast<int64_t>(k) * (span - 1) / (samples - 1));
+      try {
+        greys[static_cast<size_t>(k)] = ToGrey(reader.ReadRgb(frame));
+      } catch (const Error&) {
+      }
+    }
+  };
+  RunConcurrently([&] { read_every_other(0); }, [&] { read_every_other(1); });
+  greys.erase(std::remove_if(greys.begin(), greys.end(), [](const cv::Mat& grey) { return grey.empty(); }),
+              greys.end());
+  return greys;
+}
+
+double ShareOfImage(const cv::Mat& regions) {
+  return regions.empty() ? 0.0 : cv::countNonZero(regions) / static_cast<double>(regions.total());
+}
+
+std::string FrameRange(int first, int last) {
+  return "frames " + std::to_string(first) + "-" + std::to_string(last - 1);
+}
+
+}  // namespace
+
+std::vector<std::pair<int, int>> StaticWindows(int frame_count, double fps, const MaskOptions& options) {
+  if (options.static_frames == 0 || frame_count <= 0 || frame_count / fps < options.static_min_seconds) return {};
+  const int length = std::max(1, static_cast<int>(std::lround(options.static_window_seconds * fps)));
+  if (frame_count <= length) return {{0, frame_count}};
+  const int step = std::max(1, length / 2);
+  std::vector<std::pair<int, int>> windows;
+  for (int first = 0; first + length < frame_count; first += step) windows.emplace_back(first, first + length);
+  windows.emplace_back(frame_count - length, frame_count);
+  return windows;
+}
+
+StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const MaskOptions& options, std::ostream& log) {
+  StaticRegions found;
+  if (options.static_frames == 0) return found;
+  const double seconds = reader.frame_count() / reader.info().fps;
+  if (seconds < options.static_min_seconds) {
+    log << "not looked for regions that never change (an on-screen display): the sequence spans "
+        << FormatFixed(seconds, 1) << " s, under static_min_seconds = " << FormatFixed(options.static_min_seconds, 1)
+        << " s\n";
+    return found;
+  }
+  std::vector<Span> windows;  // those with regions
+  for (const auto& [first, last] : StaticWindows(reader.frame_count(), reader.info().fps, options)) {
+    const int samples = std::min(options.static_frames, last - first);
+    if (samples < MaskOptions::kMinStaticFrames) continue;
+    const std::vector<cv::Mat> greys = ReadSpreadGreys(reader, first, last, samples);
+    if (greys.size() < static_cast<size_t>(MaskOptions::kMinStaticFrames)) continue;
+    cv::Mat regions = FindStaticRegions(greys, reader.fixed_mask(), options);
+    const double share = ShareOfImage(regions);
+    if (share > options.static_max_fraction) {
+      log << FrameRange(first, last) << ": " << std::lround(100 * share)
+          << " % of the image never changed: a still view rather than a display, so none of it was left out\n";
+    } else if (share > 0) {
+      log << FrameRange(first, last) << ": " << FormatFixed(100 * share, 1)
+          << " % of the image never changed and is left out of them\n";
+      windows.push_back({first, last, std::move(regions)});
+    }
+  }
+  // Where windows overlap, a frame loses what either found.
+  std::set<int> bounds;
+  for (const Span& window : windows) bounds.insert({window.first, window.last});
+  for (auto bound = bounds.begin(); bound != bounds.end() && std::next(bound) != bounds.end(); ++bound) {
+    Span span{*bound, *std::next(bound), cv::Mat()};
+    for (const Span& window : windows) {
+      if (window.first > span.first || window.last < span.last) continue;
+      if (span.regions.empty()) {
+        span.regions = window.regions.clone();
+      } else {
+        span.regions |= window.regions;
+      }
+    }
+    if (!span.regions.empty()) found.spans_.push_back(std::move(span));
+  }
+  return found;
+}
+
+const cv::Mat& StaticRegions::At(int frame) const {
+  static const cv::Mat kNone;
+  for (const Span& span : spans_) {
+    if (frame >= span.first && frame < span.last) return span.regions;
+  }
+  return kNone;
+}
+
+cv::Mat StaticRegions::Union() const {
+  cv::Mat all;
+  for (const Span& span : spans_) {
+    if (all.empty()) {
+      all = span.regions.clone();
+    } else {
+      all |= span.regions;
+    }
+  }
+  return all;
+}
+
+double StaticRegions::Fraction() const { return ShareOfImage(Union()); }
+
+}  // namespace nrslam
