@@ -35,6 +35,7 @@
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/run_sequence.h"
+#include "nrslam/system/static_regions.h"
 #include "nrslam/tracking/tracker.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
@@ -1358,13 +1359,13 @@ TEST_F(RunSequenceTest, AFrameOfNoiseIsSkippedAsADropout) {
   ExpectLostFromFrame(folder, count_only, 15);
 }
 
-// Paints an on-screen display's two lines of grey text on every frame of `sequence`; returns
-// the strokes.
-cv::Mat PaintDisplay(const fs::path& sequence) {
+// Paints an on-screen display's two lines of grey text on the first `frames` frames of
+// `sequence` (the fixture's 40: every frame); returns the strokes.
+cv::Mat PaintDisplay(const fs::path& sequence, int frames = 40) {
   cv::Mat strokes(240, 320, CV_8UC1, cv::Scalar(0));
   cv::putText(strokes, "CV-190  ID 0042", {20, 40}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
   cv::putText(strokes, "Eh:A3 Cm:1", {20, 205}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255), 2);
-  for (int frame = 0; frame < 40; ++frame) {
+  for (int frame = 0; frame < frames; ++frame) {
     const fs::path file = sequence / "rgb" / FrameFileName(frame);
     cv::Mat image = cv::imread(file.string());
     image.setTo(cv::Scalar(150, 225, 150), strokes);
@@ -1458,6 +1459,58 @@ TEST_F(RunSequenceTest, AShortRunIsCheckedForADisplayOverItsWholeSequence) {
   const cv::Mat static_mask = cv::imread((folder / "run" / "static_mask.png").string(), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(static_mask.empty());
   EXPECT_EQ(cv::countNonZero(static_mask & strokes), cv::countNonZero(strokes));
+}
+
+// A display shown for the first half of a sequence only is static in half its frames, too few
+// for the check over the whole sequence; in windows of 8 s (the fixture's 40 frames at 2.5 fps:
+// 16 s) the first window is all display, and its frames leave it out while the later frames,
+// without it, keep the whole view.
+TEST_F(RunSequenceTest, ADisplayShownForAWhileIsLeftOutOfItsFramesOnly) {
+  const fs::path folder = CopyOfSequence("display_for_a_while");
+  const fs::path sequence = folder / "sequence";
+  const cv::Mat strokes = PaintDisplay(sequence, 20);
+  nlohmann::json info = ReadJsonFile(sequence / "sequence.json");
+  info["fps"] = 2.5;
+  std::ofstream(sequence / "sequence.json") << info.dump(2);
+  const SequenceReader reader(sequence);
+  const MaskOptions masks;
+  EXPECT_EQ(StaticWindows(40, 2.5, masks), (std::vector<std::pair<int, int>>{{0, 20}, {10, 30}, {20, 40}}));
+  std::ostringstream log;
+  const StaticRegions found = StaticRegions::OfSequence(reader, masks, log);
+  for (int frame : {0, 10, 19}) {
+    ASSERT_FALSE(found.At(frame).empty()) << frame;
+    EXPECT_EQ(cv::countNonZero(found.At(frame) & strokes), cv::countNonZero(strokes)) << frame;
+  }
+  for (int frame : {20, 39}) EXPECT_TRUE(found.At(frame).empty()) << frame;
+  EXPECT_EQ(cv::countNonZero(found.Union() & strokes), cv::countNonZero(strokes));
+  EXPECT_NE(log.str().find("frames 0-19: "), std::string::npos) << log.str();
+
+  const RunSummary run = RunSequence(sequence, TrackingExperiment(), folder / "run");
+  EXPECT_EQ(run.frames_tracked, 40);
+  EXPECT_NEAR(run.input.static_fraction, found.Fraction(), 1e-12);
+  EXPECT_GT(run.input.static_fraction, 0.02);
+  EXPECT_EQ(CountLines(folder / "run" / "run.log", "frames 0-19: "), 1);
+
+  // One window over the whole sequence, as before windows: half the frames are too few.
+  SystemOptions whole = TrackingExperiment();
+  whole.frontend.masks.static_window_seconds = 16;
+  EXPECT_EQ(RunSequence(sequence, whole, folder / "whole").input.static_fraction, 0);
+}
+
+// Windows of static_window_seconds, half a window apart, the last one ending with the sequence;
+// one window over a sequence no longer than one; none when the check is off or the sequence short.
+TEST(StaticWindows, CoverTheSequenceHalfAWindowApart) {
+  const MaskOptions masks;  // 8 s windows, sequences of 3.5 s or more
+  using Windows = std::vector<std::pair<int, int>>;
+  EXPECT_EQ(StaticWindows(120, 30, masks), (Windows{{0, 120}}));
+  EXPECT_EQ(StaticWindows(240, 30, masks), (Windows{{0, 240}}));
+  EXPECT_EQ(StaticWindows(300, 30, masks), (Windows{{0, 240}, {60, 300}}));
+  EXPECT_EQ(StaticWindows(1000, 30, masks),
+            (Windows{{0, 240}, {120, 360}, {240, 480}, {360, 600}, {480, 720}, {600, 840}, {720, 960}, {760, 1000}}));
+  EXPECT_TRUE(StaticWindows(100, 30, masks).empty());  // 3.3 s
+  MaskOptions off;
+  off.static_frames = 0;
+  EXPECT_TRUE(StaticWindows(1000, 30, off).empty());
 }
 
 // Over a short sequence the tissue near the lumen's far end barely changes: 12 frames of sim-2
