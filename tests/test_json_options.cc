@@ -134,7 +134,7 @@ TEST(JsonOptions, ReassociationConsensusIsACount) {
 TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
   const FrontendOptions off =
       WithAssignments(FrontendOptions{}, {"masks.static_frames=0", "masks.static_min_edge=8",
-                                          "masks.static_min_seconds=1.5"});
+                                          "masks.static_min_seconds=1.5", "masks.static_window_seconds=12"});
   EXPECT_EQ(Json(OptionsFromJson<FrontendOptions>(Json(off), "test")), Json(off));
   EXPECT_EQ(off.masks.static_frames, 0);
   EXPECT_EQ(FrontendOptions{}.masks.static_frames, 24);
@@ -146,6 +146,12 @@ TEST(JsonOptions, StaticRegionOptionsAreValidatedAndRoundTrip) {
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_max_fraction=1.5"}), Error);
   EXPECT_EQ(off.masks.static_min_seconds, 1.5);
   EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_min_seconds=-1"}), Error);
+  EXPECT_EQ(off.masks.static_window_seconds, 12);
+  EXPECT_EQ(FrontendOptions{}.masks.static_window_seconds, 8);
+  // Windows shorter than the shortest span the check trusts would find still tissue.
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_window_seconds=2"}), Error);
+  EXPECT_THROW(WithAssignments(FrontendOptions{}, {"masks.static_window_seconds=0", "masks.static_min_seconds=0"}),
+               Error);
 }
 
 TEST(JsonOptions, DropoutShareIsAFraction) {
