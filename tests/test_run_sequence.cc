@@ -1476,7 +1476,7 @@ TEST_F(RunSequenceTest, ADisplayShownForAWhileIsLeftOutOfItsFramesOnly) {
   const MaskOptions masks;
   EXPECT_EQ(StaticWindows(40, 2.5, masks), (std::vector<std::pair<int, int>>{{0, 20}, {10, 30}, {20, 40}}));
   std::ostringstream log;
-  const StaticRegions found = StaticRegions::OfSequence(reader, masks, log);
+  const StaticRegions found = StaticRegions::OfSequence(reader, masks, 0, 40, log);
   for (int frame : {0, 10, 19}) {
     ASSERT_FALSE(found.At(frame).empty()) << frame;
     EXPECT_EQ(cv::countNonZero(found.At(frame) & strokes), cv::countNonZero(strokes)) << frame;
@@ -1484,6 +1484,10 @@ TEST_F(RunSequenceTest, ADisplayShownForAWhileIsLeftOutOfItsFramesOnly) {
   for (int frame : {20, 39}) EXPECT_TRUE(found.At(frame).empty()) << frame;
   EXPECT_EQ(cv::countNonZero(found.Union() & strokes), cv::countNonZero(strokes));
   EXPECT_NE(log.str().find("frames 0-19: "), std::string::npos) << log.str();
+  // A run of the last frames looks at the windows that hold them only.
+  std::ostringstream late_log;
+  EXPECT_EQ(StaticRegions::OfSequence(reader, masks, 30, 40, late_log).Fraction(), 0);
+  EXPECT_EQ(late_log.str().find("frames 0-19: "), std::string::npos) << late_log.str();
 
   const RunSummary run = RunSequence(sequence, TrackingExperiment(), folder / "run");
   EXPECT_EQ(run.frames_tracked, 40);

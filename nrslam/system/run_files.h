@@ -45,8 +45,9 @@ struct InputEffects {
   // Frames tracked although the view jumped (FrameResult::view_jump): frames missing from the
   // recording, or a jerk of the scope.
   int view_jumps = 0;
-  // The share of the image left out because it never changed over the sequence (an on-screen
-  // display, an unmasked black border; frontend FindStaticRegions, margin included).
+  // The share of the image left out on some frame because it never changed over the sequence
+  // or a window of it (an on-screen display, an unmasked black border; system/static_regions.h,
+  // margin included).
   double static_fraction = 0;
   // One note each, those that apply, in the order the runner and nrslam_eval print them:
   // unreadable files, sparse ground truth, image dropouts, sudden occlusions, jumps of the view,

@@ -12,7 +12,6 @@
 #include <utility>
 
 #include "nrslam/eval/depth_evaluation.h"
-#include "nrslam/frontend/masks.h"
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
@@ -20,7 +19,6 @@
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/system/static_regions.h"
 #include "nrslam/tracking/tracker.h"
-#include "nrslam/util/concurrent.h"
 #include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/memory_usage.h"
@@ -192,7 +190,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned_maps;  // tracked camera centres per map, with their truth
   const auto start = Clock::now();
-  StaticRegions static_regions = StaticRegions::OfSequence(reader, options.frontend.masks, log);
+  StaticRegions static_regions = StaticRegions::OfSequence(reader, options.frontend.masks, first, last, log);
   summary.input.static_fraction = static_regions.Fraction();
   if (summary.input.static_fraction > 0) {
     const fs::path file = out / "static_mask.png";

@@ -54,7 +54,8 @@ std::vector<std::pair<int, int>> StaticWindows(int frame_count, double fps, cons
   return windows;
 }
 
-StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const MaskOptions& options, std::ostream& log) {
+StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const MaskOptions& options, int first_run_frame,
+                                        int last_run_frame, std::ostream& log) {
   StaticRegions found;
   if (options.static_frames == 0) return found;
   const double seconds = reader.frame_count() / reader.info().fps;
@@ -66,6 +67,7 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
   }
   std::vector<Span> windows;  // those with regions
   for (const auto& [first, last] : StaticWindows(reader.frame_count(), reader.info().fps, options)) {
+    if (last <= first_run_frame || first >= last_run_frame) continue;  // none of the run's frames
     const int samples = std::min(options.static_frames, last - first);
     if (samples < MaskOptions::kMinStaticFrames) continue;
     const std::vector<cv::Mat> greys = ReadSpreadGreys(reader, first, last, samples);

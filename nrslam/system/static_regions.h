@@ -25,12 +25,14 @@ std::vector<std::pair<int, int>> StaticWindows(int frame_count, double fps, cons
 class StaticRegions {
  public:
   StaticRegions() = default;
-  // Looks at `reader`'s whole sequence, window by window (frontend FindStaticRegions over
-  // `static_frames` frames spread over each; a window with more than `static_max_fraction` of
-  // the image static is a still view and keeps all of it). Says in `log` what it found and
-  // where, or why it did not look. Frames that cannot be read are passed over here; a run
-  // reports them when it reaches them.
-  static StaticRegions OfSequence(const SequenceReader& reader, const MaskOptions& options, std::ostream& log);
+  // Looks at the windows of `reader`'s sequence (StaticWindows) that hold any of the frames
+  // [first, last) a run takes: frontend FindStaticRegions over `static_frames` frames spread over
+  // each, read from the whole window even where the run takes part of it; a window with more
+  // than `static_max_fraction` of the image static is a still view and keeps all of it. Says in
+  // `log` what it found and where, or why it did not look. Frames that cannot be read are passed
+  // over here; a run reports them when it reaches them.
+  static StaticRegions OfSequence(const SequenceReader& reader, const MaskOptions& options, int first, int last,
+                                  std::ostream& log);
 
   // Non-zero where `frame` is left out: the regions of every window holding it. Empty when none.
   const cv::Mat& At(int frame) const;
