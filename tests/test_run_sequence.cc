@@ -1512,6 +1512,8 @@ TEST(StaticWindows, CoverTheSequenceHalfAWindowApart) {
   EXPECT_EQ(StaticWindows(1000, 30, masks),
             (Windows{{0, 240}, {120, 360}, {240, 480}, {360, 600}, {480, 720}, {600, 840}, {720, 960}, {760, 1000}}));
   EXPECT_TRUE(StaticWindows(100, 30, masks).empty());  // 3.3 s
+  // At 1 fps 8 s are 8 frames, too few to tell: windows of 10.
+  EXPECT_EQ(StaticWindows(30, 1, masks), (Windows{{0, 10}, {5, 15}, {10, 20}, {15, 25}, {20, 30}}));
   MaskOptions off;
   off.static_frames = 0;
   EXPECT_TRUE(StaticWindows(1000, 30, off).empty());

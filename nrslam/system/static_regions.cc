@@ -45,7 +45,9 @@ std::string FrameRange(int first, int last) {
 
 std::vector<std::pair<int, int>> StaticWindows(int frame_count, double fps, const MaskOptions& options) {
   if (options.static_frames == 0 || frame_count <= 0 || frame_count / fps < options.static_min_seconds) return {};
-  const int length = std::max(1, static_cast<int>(std::lround(options.static_window_seconds * fps)));
+  // At a low frame rate (a capsule's 1-2 fps) a window still holds the frames a verdict needs.
+  const int length =
+      std::max(MaskOptions::kMinStaticFrames, static_cast<int>(std::lround(options.static_window_seconds * fps)));
   if (frame_count <= length) return {{0, frame_count}};
   const int step = std::max(1, length / 2);
   std::vector<std::pair<int, int>> windows;
@@ -63,6 +65,11 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
     log << "not looked for regions that never change (an on-screen display): the sequence spans "
         << FormatFixed(seconds, 1) << " s, under static_min_seconds = " << FormatFixed(options.static_min_seconds, 1)
         << " s\n";
+    return found;
+  }
+  if (reader.frame_count() < MaskOptions::kMinStaticFrames) {
+    log << "not looked for regions that never change (an on-screen display): " << reader.frame_count()
+        << " frames, under the " << MaskOptions::kMinStaticFrames << " that can tell\n";
     return found;
   }
   std::vector<Span> windows;  // those with regions

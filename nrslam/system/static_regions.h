@@ -16,9 +16,9 @@
 namespace nrslam {
 
 // The frame ranges [first, last) looked at for static regions in a sequence of `frame_count`
-// frames at `fps`: windows of `options.static_window_seconds`, each starting half a window after
-// the one before, the last one ending with the sequence; a single window over all of a sequence
-// no longer than one. None when the check is off, or the sequence spans under
+// frames at `fps`: windows of `options.static_window_seconds` (and of at least
+// MaskOptions::kMinStaticFrames frames), each starting half a window after the one before, the
+// last one ending with the sequence; a single window over all of a sequence no longer than one. None when the check is off, or the sequence spans under
 // `static_min_seconds` (tissue the camera barely moves past would pass for a display).
 std::vector<std::pair<int, int>> StaticWindows(int frame_count, double fps, const MaskOptions& options);
 
