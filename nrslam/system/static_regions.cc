@@ -72,9 +72,38 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
         << " frames, under the " << MaskOptions::kMinStaticFrames << " that can tell\n";
     return found;
   }
-  std::vector<Span> windows;  // those with regions
+  // Windows come in frame order, so the frames before a window's first are final once it comes:
+  // their spans are made then, and only the windows that may still share frames with later
+  // ones are kept (at most three), whatever the sequence's length.
+  std::vector<Span> open;  // windows with regions that end after `done`
+  int done = 0;            // frames before this have their spans
+  const auto close_until = [&](int until) {
+    std::set<int> bounds{done, until};
+    for (const Span& window : open) {
+      for (int bound : {window.first, window.last}) {
+        if (bound > done && bound < until) bounds.insert(bound);
+      }
+    }
+    for (auto bound = bounds.begin(); std::next(bound) != bounds.end(); ++bound) {
+      // A frame in two windows loses what either found.
+      cv::Mat regions;
+      for (const Span& window : open) {
+        if (window.first > *bound || window.last < *std::next(bound)) continue;
+        if (regions.empty()) {
+          regions = window.regions.clone();
+        } else {
+          regions |= window.regions;
+        }
+      }
+      if (!regions.empty()) found.Append(*bound, *std::next(bound), std::move(regions));
+    }
+    done = until;
+    open.erase(std::remove_if(open.begin(), open.end(), [&](const Span& window) { return window.last <= done; }),
+               open.end());
+  };
   for (const auto& [first, last] : StaticWindows(reader.frame_count(), reader.info().fps, options)) {
     if (last <= first_run_frame || first >= last_run_frame) continue;  // none of the run's frames
+    close_until(first);
     const int samples = std::min(options.static_frames, last - first);
     if (samples < MaskOptions::kMinStaticFrames) continue;
     const std::vector<cv::Mat> greys = ReadSpreadGreys(reader, first, last, samples);
@@ -87,25 +116,21 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
     } else if (share > 0) {
       log << FrameRange(first, last) << ": " << FormatFixed(100 * share, 1)
           << " % of the image never changed and is left out of them\n";
-      windows.push_back({first, last, std::move(regions)});
+      open.push_back({first, last, std::move(regions)});
     }
   }
-  // Where windows overlap, a frame loses what either found.
-  std::set<int> bounds;
-  for (const Span& window : windows) bounds.insert({window.first, window.last});
-  for (auto bound = bounds.begin(); bound != bounds.end() && std::next(bound) != bounds.end(); ++bound) {
-    Span span{*bound, *std::next(bound), cv::Mat()};
-    for (const Span& window : windows) {
-      if (window.first > span.first || window.last < span.last) continue;
-      if (span.regions.empty()) {
-        span.regions = window.regions.clone();
-      } else {
-        span.regions |= window.regions;
-      }
-    }
-    if (!span.regions.empty()) found.spans_.push_back(std::move(span));
-  }
+  close_until(reader.frame_count());
   return found;
+}
+
+void StaticRegions::Append(int first, int last, cv::Mat regions) {
+  // A display on screen throughout gives every window the same regions: one span, not one
+  // image per window of a long video.
+  if (!spans_.empty() && spans_.back().last == first && cv::countNonZero(spans_.back().regions != regions) == 0) {
+    spans_.back().last = last;
+    return;
+  }
+  spans_.push_back({first, last, std::move(regions)});
 }
 
 const cv::Mat& StaticRegions::At(int frame) const {

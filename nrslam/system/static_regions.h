@@ -46,6 +46,8 @@ class StaticRegions {
     int first = 0, last = 0;  // frames [first, last)
     cv::Mat regions;          // never empty
   };
+  // Adds frames [first, last), after every span so far, with their regions (not empty).
+  void Append(int first, int last, cv::Mat regions);
   std::vector<Span> spans_;  // in frame order, not overlapping
 };
 
