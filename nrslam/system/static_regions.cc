@@ -1,5 +1,7 @@
 #include "nrslam/system/static_regions.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -32,6 +34,12 @@ std::vector<cv::Mat> ReadSpreadGreys(const SequenceReader& reader, int first, in
               greys.end());
   return greys;
 }
+
+// A window's frames [first, last) and what it found static there.
+struct Window {
+  int first = 0, last = 0;
+  cv::Mat regions;
+};
 
 double ShareOfImage(const cv::Mat& regions) {
   return regions.empty() ? 0.0 : cv::countNonZero(regions) / static_cast<double>(regions.total());
@@ -74,12 +82,12 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
   }
   // Windows come in frame order, so the frames before a window's first are final once it comes:
   // their spans are made then, and only the windows that may still share frames with later
-  // ones are kept (at most three), whatever the sequence's length.
-  std::vector<Span> open;  // windows with regions that end after `done`
+  // ones are kept whole (at most three), whatever the sequence's length.
+  std::vector<Window> open;  // windows with regions that end after `done`
   int done = 0;            // frames before this have their spans
   const auto close_until = [&](int until) {
     std::set<int> bounds{done, until};
-    for (const Span& window : open) {
+    for (const Window& window : open) {
       for (int bound : {window.first, window.last}) {
         if (bound > done && bound < until) bounds.insert(bound);
       }
@@ -87,7 +95,7 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
     for (auto bound = bounds.begin(); std::next(bound) != bounds.end(); ++bound) {
       // A frame in two windows loses what either found.
       cv::Mat regions;
-      for (const Span& window : open) {
+      for (const Window& window : open) {
         if (window.first > *bound || window.last < *std::next(bound)) continue;
         if (regions.empty()) {
           regions = window.regions.clone();
@@ -95,10 +103,10 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
           regions |= window.regions;
         }
       }
-      if (!regions.empty()) found.Append(*bound, *std::next(bound), std::move(regions));
+      if (!regions.empty()) found.Append(*bound, *std::next(bound), regions);
     }
     done = until;
-    open.erase(std::remove_if(open.begin(), open.end(), [&](const Span& window) { return window.last <= done; }),
+    open.erase(std::remove_if(open.begin(), open.end(), [&](const Window& window) { return window.last <= done; }),
                open.end());
   };
   for (const auto& [first, last] : StaticWindows(reader.frame_count(), reader.info().fps, options)) {
@@ -123,31 +131,39 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
   return found;
 }
 
-void StaticRegions::Append(int first, int last, cv::Mat regions) {
-  // A display on screen throughout gives every window the same regions: one span, not one
-  // image per window of a long video.
-  if (!spans_.empty() && spans_.back().last == first && cv::countNonZero(spans_.back().regions != regions) == 0) {
-    spans_.back().last = last;
-    return;
+void StaticRegions::Append(int first, int last, const cv::Mat& regions) {
+  size_ = regions.size();
+  cv::Mat labels, stats, centroids;
+  const int parts = cv::connectedComponentsWithStats(regions, labels, stats, centroids, 8, CV_32S);
+  Span span{first, last, {}};
+  for (int part = 1; part < parts; ++part) {
+    const cv::Rect box(stats.at<int>(part, cv::CC_STAT_LEFT), stats.at<int>(part, cv::CC_STAT_TOP),
+                       stats.at<int>(part, cv::CC_STAT_WIDTH), stats.at<int>(part, cv::CC_STAT_HEIGHT));
+    span.patches.push_back(Patch{box, cv::Mat(labels(box) == part)});
   }
-  spans_.push_back({first, last, std::move(regions)});
+  spans_.push_back(std::move(span));
 }
 
-const cv::Mat& StaticRegions::At(int frame) const {
-  static const cv::Mat kNone;
+cv::Mat StaticRegions::Regions(const Span& span) const {
+  cv::Mat regions(size_, CV_8UC1, cv::Scalar(0));
+  for (const Patch& patch : span.patches) regions(patch.box) |= patch.mask;
+  return regions;
+}
+
+cv::Mat StaticRegions::At(int frame) const {
   for (const Span& span : spans_) {
-    if (frame >= span.first && frame < span.last) return span.regions;
+    if (frame >= span.first && frame < span.last) return Regions(span);
   }
-  return kNone;
+  return {};
 }
 
 cv::Mat StaticRegions::Union() const {
   cv::Mat all;
   for (const Span& span : spans_) {
     if (all.empty()) {
-      all = span.regions.clone();
+      all = Regions(span);
     } else {
-      all |= span.regions;
+      all |= Regions(span);
     }
   }
   return all;

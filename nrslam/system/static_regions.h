@@ -18,8 +18,9 @@ namespace nrslam {
 // The frame ranges [first, last) looked at for static regions in a sequence of `frame_count`
 // frames at `fps`: windows of `options.static_window_seconds` (and of at least
 // MaskOptions::kMinStaticFrames frames), each starting half a window after the one before, the
-// last one ending with the sequence; a single window over all of a sequence no longer than one. None when the check is off, or the sequence spans under
-// `static_min_seconds` (tissue the camera barely moves past would pass for a display).
+// last one ending with the sequence; a single window over all of a sequence no longer than one.
+// None when the check is off, or the sequence spans under `static_min_seconds` (tissue the
+// camera barely moves past would pass for a display).
 std::vector<std::pair<int, int>> StaticWindows(int frame_count, double fps, const MaskOptions& options);
 
 class StaticRegions {
@@ -35,19 +36,27 @@ class StaticRegions {
                                   std::ostream& log);
 
   // Non-zero where `frame` is left out: the regions of every window holding it. Empty when none.
-  const cv::Mat& At(int frame) const;
+  cv::Mat At(int frame) const;
   // Every pixel left out on some frame (empty when none): the run's static_mask.png.
   cv::Mat Union() const;
   // Union()'s share of the image (0 when none).
   double Fraction() const;
 
  private:
+  // A connected part of a span's regions, cropped to its box. A display is a few small shapes,
+  // so each span of a long video holds kilobytes rather than an image.
+  struct Patch {
+    cv::Rect box;
+    cv::Mat mask;  // the part's pixels within `box`
+  };
   struct Span {
-    int first = 0, last = 0;  // frames [first, last)
-    cv::Mat regions;          // never empty
+    int first = 0, last = 0;     // frames [first, last)
+    std::vector<Patch> patches;  // never empty
   };
   // Adds frames [first, last), after every span so far, with their regions (not empty).
-  void Append(int first, int last, cv::Mat regions);
+  void Append(int first, int last, const cv::Mat& regions);
+  cv::Mat Regions(const Span& span) const;
+  cv::Size size_;
   std::vector<Span> spans_;  // in frame order, not overlapping
 };
 
