@@ -84,7 +84,7 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
   // their spans are made then, and only the windows that may still share frames with later
   // ones are kept whole (at most three), whatever the sequence's length.
   std::vector<Window> open;  // windows with regions that end after `done`
-  int done = 0;            // frames before this have their spans
+  int done = 0;              // frames before this have their spans
   const auto close_until = [&](int until) {
     std::set<int> bounds{done, until};
     for (const Window& window : open) {
@@ -112,9 +112,9 @@ StaticRegions StaticRegions::OfSequence(const SequenceReader& reader, const Mask
   for (const auto& [first, last] : StaticWindows(reader.frame_count(), reader.info().fps, options)) {
     if (last <= first_run_frame || first >= last_run_frame) continue;  // none of the run's frames
     close_until(first);
-    const int samples = std::min(options.static_frames, last - first);
-    if (samples < MaskOptions::kMinStaticFrames) continue;
-    const std::vector<cv::Mat> greys = ReadSpreadGreys(reader, first, last, samples);
+    // A window holds at least kMinStaticFrames frames, and static_frames is at least that.
+    const std::vector<cv::Mat> greys =
+        ReadSpreadGreys(reader, first, last, std::min(options.static_frames, last - first));
     if (greys.size() < static_cast<size_t>(MaskOptions::kMinStaticFrames)) continue;
     cv::Mat regions = FindStaticRegions(greys, reader.fixed_mask(), options);
     const double share = ShareOfImage(regions);
