@@ -676,6 +676,38 @@ RunResult GridRun(const std::string& sequence, const std::string& k, const std::
   return r;
 }
 
+// results.md and results.tex hold the printed tables, the notes under them, and a sweep's
+// summary: what nrslam_eval prints, ready for notes and papers.
+TEST(Results, TablesAreWrittenAsMarkdownAndLatex) {
+  const auto folder = UniqueTempFolder("results_tables");
+  std::vector<RunResult> results = {GridRun("sim_3", "2", "5", false, 0.707), GridRun("sim_3", "10", "5", true, 1.5)};
+  results[1].stop_frame = 90;
+  results[1].stop_reason = "only 7 points left after outlier rejection";
+  RunResult failed = GridRun("lap", "2", "5", false, 0);
+  failed.status = "failed";
+  failed.error = "cannot read rgb/000003.png";
+  results.push_back(failed);
+  WriteResults(results, folder);
+  const auto contents = [&](const char* name) {
+    std::ifstream in(folder / name);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string markdown = contents("results.md");
+  const std::string latex = contents("results.tex");
+  EXPECT_EQ(markdown.rfind("| sequence | sweep point | status | init | tracked | RMSE mm |", 0), 0u) << markdown;
+  EXPECT_NE(markdown.find("| sim_3 | k=2 D=5 | ok |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("| 0.707 |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("- sim_3 [k=10 D=5]: lost from frame 90: only 7 points left"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("- FAILED lap [k=2 D=5]: cannot read rgb/000003.png"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Per swept value, over the 0 sequence(s)"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("| deformation.k | 2 |"), std::string::npos) << markdown;
+  EXPECT_NE(latex.find("\\begin{tabular}{lrrrrrrrrrrr}\n\\toprule\n"), std::string::npos) << latex;
+  EXPECT_NE(latex.find("sim\\_3 & k=2 D=5 & ok & 0 & 0/0 & 0.707 &"), std::string::npos) << latex;
+  EXPECT_NE(latex.find("% FAILED lap [k=2 D=5]: cannot read rgb/000003.png\n"), std::string::npos) << latex;
+  EXPECT_NE(latex.find("deformation.k & 2 &"), std::string::npos) << latex;
+  std::filesystem::remove_all(folder);
+}
+
 // Known answers for a 2 × 2 grid (k, D) over three sequences, one of which is lost at k = 10:
 // only the two sequences complete at every point count, each value sees 2 points × 2 sequences.
 TEST(Results, SweepSummaryAveragesEachValueOverTheSameSequences) {

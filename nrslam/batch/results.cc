@@ -336,38 +336,19 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
   return results;
 }
 
-void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
-  WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
-  std::ostringstream csv;
-  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
-         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
-         "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
-         "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
-         "birth_log_error_median,revision,code,error\n";
-  for (const RunResult& r : results) {
-    csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
-        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
-        << r.input.frames_unreadable << ',' << r.input.frames_unreadable_after_init << ','
-        << r.input.frames_groundtruth_unreadable << ',' << r.input.frames_sparse_groundtruth << ','
-        << r.input.frames_dropout << ',' << r.input.sudden_occlusions << ',' << r.input.view_jumps << ','
-        << r.input.static_fraction << ','
-        << r.rmse_mm << ',' << r.rmse_median_mm << ','
-        << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
-        << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
-        << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
-        << ',' << RecordedField(r.birth_log_error_median) << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
-  }
-  WriteTextFile(folder / "results.csv", csv.str());
-}
 
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder) {
   return ResultsFromJson(ReadJsonFile(folder / "results.json"));
 }
 
-void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
-  bool swept = false;
-  for (const RunResult& r : results) swept |= !r.label.empty();
+namespace {
+
+bool Swept(const std::vector<RunResult>& results) {
+  return std::any_of(results.begin(), results.end(), [](const RunResult& r) { return !r.label.empty(); });
+}
+
+TextTable ResultsTable(const std::vector<RunResult>& results) {
+  const bool swept = Swept(results);
   std::vector<std::string> header = {"sequence"};
   if (swept) header.push_back("sweep point");
   for (const char* column : {"status", "init", "tracked", "RMSE mm", "median mm", "flat mm", "1 scale mm", "ATE mm", "fps", "MB"}) {
@@ -389,20 +370,90 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
     }
     table.AddRow(row);
   }
-  table.Print(out);
+  return table;
+}
+
+// What went wrong or was noted per run, one line each: "FAILED key: error", "key: note".
+std::vector<std::string> ResultNoteLines(const std::vector<RunResult>& results) {
+  std::vector<std::string> lines;
   for (const RunResult& r : results) {
-    if (r.status == "failed") out << "FAILED " << RunKey(r) << ": " << r.error << '\n';
-    for (const std::string& note : RunNotes(r)) out << RunKey(r) << ": " << note << '\n';
+    if (r.status == "failed") lines.push_back("FAILED " + RunKey(r) + ": " + r.error);
+    for (const std::string& note : RunNotes(r)) lines.push_back(RunKey(r) + ": " + note);
   }
-  if (!swept) return;
-  const std::vector<SweepValueSummary> values = SummariseSweep(results);
+  return lines;
+}
+
+std::string SweepSummaryTitle(const std::vector<RunResult>& results) {
   int sequences = 0;
   for (const auto& [name, ok] : CompleteSequences(results)) sequences += ok;
-  out << "\nPer swept value, over the " << sequences << " sequence(s) tracked to the end at every point"
-      << " (not to end: that value's runs, over all sequences, lost or failed):\n";
+  return "Per swept value, over the " + std::to_string(sequences) + " sequence(s) tracked to the end at every point" +
+         " (not to end: that value's runs, over all sequences, lost or failed):";
+}
+
+TextTable SweepSummaryTable(const std::vector<RunResult>& results) {
   TextTable summary(SweepSummaryHeader());
-  for (const SweepValueSummary& v : values) summary.AddRow(SweepSummaryCells(v));
-  summary.Print(out);
+  for (const SweepValueSummary& v : SummariseSweep(results)) summary.AddRow(SweepSummaryCells(v));
+  return summary;
+}
+
+// results.md and results.tex in `folder`: the printed tables, to paste into notes and papers.
+void WriteResultTables(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
+  std::ostringstream markdown, latex;
+  const TextTable table = ResultsTable(results);
+  table.PrintMarkdown(markdown);
+  latex << "% nrslam_eval's results table (needs \\usepackage{booktabs})\n";
+  table.PrintLatex(latex);
+  const std::vector<std::string> notes = ResultNoteLines(results);
+  if (!notes.empty()) markdown << '\n';
+  for (const std::string& line : notes) {
+    markdown << "- " << line << '\n';
+    latex << "% " << line << '\n';
+  }
+  if (Swept(results)) {
+    const TextTable summary = SweepSummaryTable(results);
+    markdown << '\n' << SweepSummaryTitle(results) << "\n\n";
+    summary.PrintMarkdown(markdown);
+    latex << "\n% " << SweepSummaryTitle(results) << '\n';
+    summary.PrintLatex(latex);
+  }
+  WriteTextFile(folder / "results.md", markdown.str());
+  WriteTextFile(folder / "results.tex", latex.str());
+}
+
+}  // namespace
+
+void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
+  ResultsTable(results).Print(out);
+  for (const std::string& line : ResultNoteLines(results)) out << line << '\n';
+  if (!Swept(results)) return;
+  out << '\n' << SweepSummaryTitle(results) << '\n';
+  SweepSummaryTable(results).Print(out);
+}
+
+void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
+  WriteResultTables(results, folder);
+  std::ostringstream csv;
+  csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
+         "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
+         "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
+         "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
+         "birth_log_error_median,revision,code,error\n";
+  for (const RunResult& r : results) {
+    csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
+        << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
+        << r.input.frames_unreadable << ',' << r.input.frames_unreadable_after_init << ','
+        << r.input.frames_groundtruth_unreadable << ',' << r.input.frames_sparse_groundtruth << ','
+        << r.input.frames_dropout << ',' << r.input.sudden_occlusions << ',' << r.input.view_jumps << ','
+        << r.input.static_fraction << ','
+        << r.rmse_mm << ',' << r.rmse_median_mm << ','
+        << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
+        << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
+        << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
+        << ',' << RecordedField(r.birth_log_error_median) << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
+  }
+  WriteTextFile(folder / "results.csv", csv.str());
 }
 
 std::vector<std::string> SweepSummaryHeader() {

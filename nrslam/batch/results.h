@@ -115,7 +115,8 @@ std::vector<RunResult> CollectResults(const EvaluationPlan& plan);
 Json ToJson(const std::vector<RunResult>& results);
 std::vector<RunResult> ResultsFromJson(const Json& json);
 
-// results.json and results.csv in `folder`.
+// results.json and results.csv in `folder`, and the printed tables (PrintResults) as
+// results.md (Markdown) and results.tex (a LaTeX tabular, booktabs).
 void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder);
 // Reads a folder's results.json; throws Error if it has none.
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder);

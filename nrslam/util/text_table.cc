@@ -28,6 +28,52 @@ void TextTable::Print(std::ostream& out) const {
   for (const auto& row : rows_) print_row(row);
 }
 
+namespace {
+
+std::string MarkdownCell(const std::string& text) {
+  std::string escaped;
+  for (char c : text) escaped += c == '|' ? std::string("\\|") : std::string(1, c);
+  return escaped;
+}
+
+std::string LatexCell(const std::string& text) {
+  std::string escaped;
+  for (char c : text) {
+    switch (c) {
+      case '\\': escaped += "\\textbackslash{}"; break;
+      case '~': escaped += "\\textasciitilde{}"; break;
+      case '^': escaped += "\\textasciicircum{}"; break;
+      case '&': case '%': case '$': case '#': case '_': case '{': case '}': escaped += std::string("\\") + c; break;
+      default: escaped += c;
+    }
+  }
+  return escaped;
+}
+
+// The cells of `row` rendered by `cell`, as many as the header has, joined by `separator`.
+std::string JoinCells(const std::vector<std::string>& row, size_t columns, std::string (*cell)(const std::string&),
+                      const std::string& separator) {
+  std::vector<std::string> cells;
+  for (size_t c = 0; c < columns; ++c) cells.push_back(cell(c < row.size() ? row[c] : ""));
+  return Join(cells, separator);
+}
+
+}  // namespace
+
+void TextTable::PrintMarkdown(std::ostream& out) const {
+  out << "| " << JoinCells(header_, header_.size(), MarkdownCell, " | ") << " |\n|";
+  for (size_t c = 0; c < header_.size(); ++c) out << (c ? " ---: |" : " :--- |");
+  out << '\n';
+  for (const auto& row : rows_) out << "| " << JoinCells(row, header_.size(), MarkdownCell, " | ") << " |\n";
+}
+
+void TextTable::PrintLatex(std::ostream& out) const {
+  out << "\\begin{tabular}{l" << std::string(header_.empty() ? 0 : header_.size() - 1, 'r') << "}\n\\toprule\n"
+      << JoinCells(header_, header_.size(), LatexCell, " & ") << " \\\\\n\\midrule\n";
+  for (const auto& row : rows_) out << JoinCells(row, header_.size(), LatexCell, " & ") << " \\\\\n";
+  out << "\\bottomrule\n\\end{tabular}\n";
+}
+
 std::string FormatDuration(double seconds) {
   const long rounded = std::lround(std::max(0.0, seconds));
   if (rounded < 90) return std::to_string(rounded) + " s";

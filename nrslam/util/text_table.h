@@ -13,6 +13,11 @@ class TextTable {
   void AddRow(std::vector<std::string> row) { rows_.push_back(std::move(row)); }
   // Columns right-aligned except the first; a rule under the header.
   void Print(std::ostream& out) const;
+  // The same table as Markdown (a pipe table, aligned as Print aligns it), for notes and issues.
+  void PrintMarkdown(std::ostream& out) const;
+  // The same table as a LaTeX tabular with booktabs rules, LaTeX's special characters escaped,
+  // to paste into a paper (needs \usepackage{booktabs}).
+  void PrintLatex(std::ostream& out) const;
 
  private:
   std::vector<std::string> header_;
