@@ -681,6 +681,11 @@ RunResult GridRun(const std::string& sequence, const std::string& k, const std::
 TEST(Results, TablesAreWrittenAsMarkdownAndLatex) {
   const auto folder = UniqueTempFolder("results_tables");
   std::vector<RunResult> results = {GridRun("sim_3", "2", "5", false, 0.707), GridRun("sim_3", "10", "5", true, 1.5)};
+  for (RunResult& r : results) {
+    r.init_frame = 0;
+    r.frames_tracked = r.frames_total = 100;
+  }
+  results[1].frames_tracked = 90;
   results[1].stop_frame = 90;
   results[1].stop_reason = "only 7 points left after outlier rejection";
   RunResult failed = GridRun("lap", "2", "5", false, 0);
@@ -702,7 +707,7 @@ TEST(Results, TablesAreWrittenAsMarkdownAndLatex) {
   EXPECT_NE(markdown.find("Per swept value, over the 0 sequence(s)"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("| deformation.k | 2 |"), std::string::npos) << markdown;
   EXPECT_NE(latex.find("\\begin{tabular}{lrrrrrrrrrrr}\n\\toprule\n"), std::string::npos) << latex;
-  EXPECT_NE(latex.find("sim\\_3 & k=2 D=5 & ok & 0 & 0/0 & 0.707 &"), std::string::npos) << latex;
+  EXPECT_NE(latex.find("sim\\_3 & k=2 D=5 & ok & 0 & 100/100 & 0.707 &"), std::string::npos) << latex;
   EXPECT_NE(latex.find("% FAILED lap [k=2 D=5]: cannot read rgb/000003.png\n"), std::string::npos) << latex;
   EXPECT_NE(latex.find("deformation.k & 2 &"), std::string::npos) << latex;
   std::filesystem::remove_all(folder);

@@ -21,10 +21,10 @@ TEST(TextTable, PrintsFixedWidthColumns) {
   std::ostringstream text;
   Example().Print(text);
   EXPECT_EQ(text.str(),
-            "sequence                 RMSE mm\n"
-            "--------------------------------\n"
-            "sim_3 [k=2|D=5]            0.707\n"
-            "50% & #1 {a} ~x^2 \\            \n");
+            "sequence             RMSE mm\n"
+            "----------------------------\n"
+            "sim_3 [k=2|D=5]        0.707\n"
+            "50% & #1 {a} ~x^2 \\         \n");
 }
 
 TEST(TextTable, PrintsAMarkdownPipeTable) {
