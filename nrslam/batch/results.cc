@@ -336,7 +336,6 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
   return results;
 }
 
-
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder) {
   return ResultsFromJson(ReadJsonFile(folder / "results.json"));
 }
@@ -410,10 +409,11 @@ void WriteResultTables(const std::vector<RunResult>& results, const std::filesys
     latex << "% " << line << '\n';
   }
   if (Swept(results)) {
+    const std::string title = SweepSummaryTitle(results);
     const TextTable summary = SweepSummaryTable(results);
-    markdown << '\n' << SweepSummaryTitle(results) << "\n\n";
+    markdown << '\n' << title << "\n\n";
     summary.PrintMarkdown(markdown);
-    latex << "\n% " << SweepSummaryTitle(results) << '\n';
+    latex << "\n% " << title << '\n';
     summary.PrintLatex(latex);
   }
   WriteTextFile(folder / "results.md", markdown.str());
