@@ -66,11 +66,7 @@ FrameImages ReadFrame(const SequenceReader& reader, int frame, const StaticRegio
   FrameImages images;
   images.bgr = reader.ReadRgb(frame);
   images.mask = reader.ReadMask(frame);
-  const cv::Mat left_out = static_regions.At(frame);
-  if (!left_out.empty()) {
-    if (images.mask.empty()) images.mask = cv::Mat(left_out.size(), CV_8UC1, cv::Scalar(255));
-    images.mask.setTo(0, left_out);
-  }
+  static_regions.LeaveOut(frame, &images.mask);
   if (reader.has_depth()) images.depth_mm = reader.TryReadDepthMm(frame, &images.depth_problem);
   return images;
 }

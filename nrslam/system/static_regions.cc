@@ -150,11 +150,23 @@ cv::Mat StaticRegions::Regions(const Span& span) const {
   return regions;
 }
 
-cv::Mat StaticRegions::At(int frame) const {
+const StaticRegions::Span* StaticRegions::SpanOf(int frame) const {
   for (const Span& span : spans_) {
-    if (frame >= span.first && frame < span.last) return Regions(span);
+    if (frame >= span.first && frame < span.last) return &span;
   }
-  return {};
+  return nullptr;
+}
+
+cv::Mat StaticRegions::At(int frame) const {
+  const Span* span = SpanOf(frame);
+  return span ? Regions(*span) : cv::Mat();
+}
+
+void StaticRegions::LeaveOut(int frame, cv::Mat* mask) const {
+  const Span* span = SpanOf(frame);
+  if (!span) return;
+  if (mask->empty()) *mask = cv::Mat(size_, CV_8UC1, cv::Scalar(255));
+  for (const Patch& patch : span->patches) (*mask)(patch.box).setTo(0, patch.mask);
 }
 
 cv::Mat StaticRegions::Union() const {

@@ -37,6 +37,9 @@ class StaticRegions {
 
   // Non-zero where `frame` is left out: the regions of every window holding it. Empty when none.
   cv::Mat At(int frame) const;
+  // Clears in `mask` (8-bit, the image's size; an empty one is made all usable first) what
+  // `frame` leaves out, part by part: the per-frame path, which builds no image of the regions.
+  void LeaveOut(int frame, cv::Mat* mask) const;
   // Every pixel left out on some frame (empty when none): the run's static_mask.png.
   cv::Mat Union() const;
   // Union()'s share of the image (0 when none).
@@ -56,6 +59,7 @@ class StaticRegions {
   // Adds frames [first, last), after every span so far, with their regions (not empty).
   void Append(int first, int last, const cv::Mat& regions);
   cv::Mat Regions(const Span& span) const;
+  const Span* SpanOf(int frame) const;  // nullptr: nothing left out of `frame`
   cv::Size size_;
   std::vector<Span> spans_;  // in frame order, not overlapping
 };
