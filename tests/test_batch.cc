@@ -433,9 +433,10 @@ TEST(Results, CsvNamesTheCodeOfEveryRun) {
   std::getline(csv, first);
   std::getline(csv, second);
   EXPECT_EQ(header.substr(header.rfind(",fps,")),
-            ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,revision,code,error");
+            ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,map_depth_change,revision,"
+            "code,error");
   EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
-  EXPECT_EQ(second.substr(second.find(",,,\"")), ",,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
+  EXPECT_EQ(second.substr(second.find(",,,,\"")), ",,,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
   std::filesystem::remove_all(folder);
 }
 
@@ -461,6 +462,34 @@ TEST(Results, BirthErrorsRoundTripAndStayEmptyWhereNoneWasScored) {
   std::getline(csv, second);
   EXPECT_NE(first.find(",12,-0.25,0.125,"), std::string::npos) << first;
   EXPECT_NE(second.find(",0,,,"), std::string::npos) << second;
+  std::filesystem::remove_all(folder);
+}
+
+// A map whose depth fell a thousandfold is noted wherever the run's notes go; one that moved
+// within kDepthChangeNoteFactor, or did not record it, is not.
+TEST(Results, MapDepthChangeRoundTripsAndAFarOneIsNoted) {
+  const auto folder = UniqueTempFolder("results_depth_change");
+  RunResult collapsed = Result("a", 1.5, 60);
+  collapsed.map_depth_change = 0.001;
+  RunResult steady = Result("b", 1.0, 60);
+  steady.map_depth_change = 0.2;
+  const RunResult older = Result("c", 1.0, 60);
+  WriteResults({collapsed, steady, older}, folder);
+  const std::vector<RunResult> read = ReadResults(folder);
+  ASSERT_EQ(read.size(), 3u);
+  EXPECT_EQ(read[0].map_depth_change, std::optional<double>(0.001));
+  EXPECT_EQ(read[1].map_depth_change, std::optional<double>(0.2));
+  EXPECT_FALSE(read[2].map_depth_change);
+  const std::vector<std::string> notes = RunNotes(read[0]);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].find("the map's median depth went ×0.001 from its first tracked frame to its last"), 0u) << notes[0];
+  EXPECT_TRUE(RunNotes(read[1]).empty());
+  EXPECT_TRUE(RunNotes(read[2]).empty());
+  std::ifstream csv(folder / "results.csv");
+  std::string header, first;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  EXPECT_NE(first.find(",0.001,"), std::string::npos) << first;
   std::filesystem::remove_all(folder);
 }
 
@@ -1296,9 +1325,9 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   std::ifstream dom_stream(dom), log_stream(log);
   const std::string page((std::istreambuf_iterator<char>(dom_stream)), {});
   const std::string browser((std::istreambuf_iterator<char>(log_stream)), {});
-  // Two tracked runs: each an RMSE plot (the run and the flat map), a scale-drift plot, a
-  // trajectory plot (two series) and three images.
-  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=6 series=10\""), std::string::npos)
+  // Two tracked runs: each an RMSE plot (the run and the flat map), a drift plot (scale and
+  // median depth), a trajectory plot (two series) and three images.
+  EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=6 series=12\""), std::string::npos)
       << page.substr(0, 2000);
   EXPECT_NE(page.find("Failed: exit code 1"), std::string::npos);
   EXPECT_NE(page.find("<h2>Deformable against rigid</h2>"), std::string::npos);

@@ -202,6 +202,58 @@ TEST_F(RunSequenceTest, SummaryRmseIsRecomputableFromPointsCsvAndGroundTruth) {
   EXPECT_TRUE(summary.at("birth_log_error_mean").is_null());
 }
 
+// metrics.csv's median_depth is the median depth of the frame's points in points.csv, and
+// summary.json's map_depth_change its last over its first. A map from depth is in millimetres,
+// so the median is also the true median there, to the tracker's drift in scale (up to 6 % on
+// these 40 frames).
+TEST_F(RunSequenceTest, MedianDepthIsRecomputableFromPointsCsvAndFollowsTheTruth) {
+  const SequenceReader reader(*base_ / "sequence");
+  std::map<int, std::vector<DepthPoint>> by_frame;
+  for (const CsvPoint& p : ReadPointsCsv(*base_ / "run" / "points.csv")) by_frame[p.frame].push_back({{p.u, p.v}, p.z});
+  std::map<int, double> recorded;
+  for (const auto& row : ReadCsv(*base_ / "run" / "metrics.csv")) {
+    recorded[std::stoi(row.at("frame"))] = row.at("median_depth").empty() ? 0 : std::stod(row.at("median_depth"));
+  }
+  ASSERT_EQ(recorded.size(), 40u);
+  ASSERT_EQ(by_frame.size(), 40u);
+  for (const auto& [frame, depth_points] : by_frame) {
+    const double median = MedianDepth(depth_points);
+    EXPECT_NEAR(recorded.at(frame), median, 1e-7 * median) << "frame " << frame;
+    const cv::Mat truth = reader.ReadDepthMm(frame);
+    std::vector<double> true_depths;
+    for (const DepthPoint& point : depth_points) {
+      if (const std::optional<double> z = SampleDepth(truth, point.pixel)) true_depths.push_back(*z);
+    }
+    EXPECT_NEAR(median, Median(true_depths), 0.1 * Median(true_depths)) << "frame " << frame;
+  }
+  nlohmann::json summary;
+  std::ifstream(*base_ / "run" / "summary.json") >> summary;
+  EXPECT_NEAR(summary.at("map_depth_change").get<double>(), recorded.at(39) / recorded.at(0), 1e-6);
+  EXPECT_EQ(DepthChangeText(summary.at("map_depth_change").get<double>()), "");
+}
+
+TEST(MapDepthDrift, IsTheChangeOfTheMapThatMovedMost) {
+  MapDepthDrift drift;
+  EXPECT_EQ(drift.Change(), 0.0);
+  drift.AddFrame(1, 2.0);
+  drift.AddFrame(1, 0.0);  // no point reported: passed over
+  drift.AddFrame(1, 1.0);  // map 1: ×0.5
+  drift.AddFrame(2, 1.0);
+  drift.AddFrame(2, 5.0);
+  drift.AddFrame(2, 3.0);  // map 2: ×3, its last over its first, not its largest
+  EXPECT_DOUBLE_EQ(drift.Change(), 3.0);
+  drift.AddFrame(3, 100.0);
+  drift.AddFrame(3, 0.01);  // map 3: ×1e-4, the largest change either way
+  EXPECT_DOUBLE_EQ(drift.Change(), 1e-4);
+  EXPECT_EQ(MedianDepth({}), 0.0);
+  EXPECT_EQ(MedianDepth({{{0, 0}, 3.0}, {{1, 1}, 1.0}, {{2, 2}, 2.0}}), 2.0);
+  EXPECT_EQ(DepthChangeText(0), "");
+  EXPECT_EQ(DepthChangeText(0.11), "");
+  EXPECT_EQ(DepthChangeText(9.5), "");
+  EXPECT_EQ(DepthChangeText(1e-4).find("the map's median depth went ×0.0001 from its first tracked frame"), 0u);
+  EXPECT_EQ(DepthChangeText(25).find("the map's median depth went ×25 from"), 0u);
+}
+
 TEST_F(RunSequenceTest, TrajectoryErrorIsRecomputableFromTheTumFilesAndSmall) {
   const SequenceReader reader(*base_ / "sequence");
   TrajectorySegment map;
@@ -244,6 +296,7 @@ TEST_F(RunSequenceTest, ScoringTheRunsOwnOutputAsAnExternalResultGivesItsSummary
   EXPECT_NEAR(summary.rmse_flat_mm, summary_->rmse_flat_mm, 1e-5);
   EXPECT_NEAR(summary.rmse_map_scale_mm, summary_->rmse_map_scale_mm, 1e-5);
   EXPECT_NEAR(summary.rmse_median_scale_mm, summary_->rmse_median_scale_mm, 1e-5);
+  EXPECT_NEAR(summary.map_depth_change, summary_->map_depth_change, 1e-7);
   ASSERT_TRUE(summary.trajectory_error.evaluated);
   EXPECT_NEAR(summary.trajectory_error.rmse_mm, summary_->trajectory_error.rmse_mm, 1e-4);
   for (const char* file : {"config.json", "points.csv", "metrics.csv", "summary.json", "trajectory.tum"}) {

@@ -112,15 +112,21 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
     const auto metrics = ReadCsv(run / "metrics.csv");
     PlotSeries rmse{"depth RMSE", "#1f77b4", {}, {}};
     PlotSeries flat{"a map at one depth", "#999999", {}, {}};  // runs before it was recorded have none
-    // The evaluator's scale relative to its map's first: what one scale per map pays for.
-    PlotSeries drift{"frame scale / map's first", "#2ca02c", {}, {}};
-    std::map<int, double> first_scale;  // per map
+    // The evaluator's scale relative to its map's first (what one scale per map pays for), and
+    // the map's median depth relative to its first, which needs no ground truth: a collapsing
+    // scale shows in both, mirrored, and a change of the scene's depth in the second alone. As
+    // log10, since a collapse spans orders of magnitude.
+    PlotSeries scale_drift{"frame scale / map's first", "#2ca02c", {}, {}};
+    PlotSeries depth_drift{"median depth / map's first", "#d62728", {}, {}};
+    std::map<int, double> first_scale, first_depth;  // per map
     std::map<int, int> map_of_frame;
     std::vector<int> tracked;
     for (const auto& row : metrics) {
       if (row.at("state") != "tracking") continue;
       const int frame = static_cast<int>(Number(row, "frame"));
-      if (row.count("map") != 0) map_of_frame[frame] = static_cast<int>(Number(row, "map"));
+      const double map_number = Number(row, "map");  // NaN in runs before it was recorded
+      const int map = std::isnan(map_number) ? 1 : static_cast<int>(map_number);
+      if (!std::isnan(map_number)) map_of_frame[frame] = map;
       rmse.x.push_back(frame);
       rmse.y.push_back(Number(row, "rmse_mm"));
       if (row.count("rmse_flat_mm") != 0) {
@@ -129,17 +135,26 @@ std::string RunSection(const RunResult& result, const std::filesystem::path& fol
       }
       const double scale = Number(row, "scale");
       if (scale > 0) {  // 0: the frame was not evaluated
-        drift.x.push_back(frame);
-        drift.y.push_back(scale / first_scale.emplace(static_cast<int>(Number(row, "map")), scale).first->second);
+        scale_drift.x.push_back(frame);
+        scale_drift.y.push_back(std::log10(scale / first_scale.emplace(map, scale).first->second));
+      }
+      const double depth = Number(row, "median_depth");  // NaN in runs before it was recorded
+      if (depth > 0) {
+        depth_drift.x.push_back(frame);
+        depth_drift.y.push_back(std::log10(depth / first_depth.emplace(map, depth).first->second));
       }
       tracked.push_back(frame);
     }
     html << "<div class=\"plots\">"
          << LinePlotSvg(flat.x.empty() ? std::vector<PlotSeries>{rmse} : std::vector<PlotSeries>{rmse, flat},
                         {"Depth RMSE per frame", "frame", "RMSE (mm)", 520, 300, false});
-    if (!drift.x.empty()) {
-      html << LinePlotSvg({drift}, {"Scale drift: each frame's scale over its map's first", "frame", "relative scale",
-                                    520, 300, false});
+    std::vector<PlotSeries> drift;
+    for (const PlotSeries& series : {scale_drift, depth_drift}) {
+      if (!series.x.empty()) drift.push_back(series);
+    }
+    if (!drift.empty()) {
+      html << LinePlotSvg(drift, {"Scale drift: each frame over its map's first", "frame", "log10 of the ratio", 520,
+                                  300, false});
     }
     if (sequence.has_groundtruth() && std::filesystem::exists(run / "trajectory.tum")) {
       const std::vector<PlotSeries> top = TopView(run / "trajectory.tum", sequence.groundtruth(), map_of_frame);

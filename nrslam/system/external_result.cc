@@ -241,6 +241,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   // Births only where ids name points from frame to frame (not rows of a frame or pixels); the
   // first frame with points is the one map's first.
   BirthErrors births;
+  MapDepthDrift depth_drift;
   bool had_points = false;
   const std::vector<EstimatedPoint> none;
   const std::string no_estimate = "no estimate of this frame in " + result.estimates.string();
@@ -251,6 +252,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     const bool tracked = !points.empty() || pose != poses.end();
     FrameEvaluation frame_evaluation;
     std::string depth_problem;  // why a tracked frame with points is not scored
+    double median_depth = 0;
     if (tracked && summary.init_frame < 0) {
       summary.init_frame = frame;
       summary.maps = 1;  // one map: another system's figures are not split by its re-initialisations
@@ -259,6 +261,8 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     if (tracked) {
       std::vector<DepthPoint> depth_points;
       for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
+      median_depth = MedianDepth(depth_points);
+      depth_drift.AddFrame(summary.maps, median_depth);
       cv::Mat depth_mm;
       if (reader.has_depth() && !points.empty()) {
         depth_mm = reader.TryReadDepthMm(frame, &depth_problem);
@@ -307,13 +311,15 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << (frame_evaluation.evaluated ? frame_evaluation.scale : 0.0) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
-                << ",0,0,0,0,0,0,0,0,"
-                << CsvField(!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem) << '\n';
+                << ",0,0,0,0,0,0,0,0,";
+    if (median_depth > 0) metrics_csv << median_depth;
+    metrics_csv << ',' << CsvField(!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem) << '\n';
     // Last used here, so its pairs move into the list kept for the alignments at the end.
     if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }
   AggregateInto(&summary, evaluations, aligned, evaluation);
   summary.births = births.Summarise();
+  summary.map_depth_change = depth_drift.Change();
   CloseWritten(points_csv, out / "points.csv");
   CloseWritten(metrics_csv, out / "metrics.csv");
   WriteTum(out / "trajectory.tum", trajectory);

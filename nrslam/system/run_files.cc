@@ -7,6 +7,7 @@
 
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/median.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_file.h"
 
@@ -68,6 +69,41 @@ std::string StaticRegionText(double static_fraction) {
   return text.str();
 }
 
+void MapDepthDrift::AddFrame(int map, double median_depth) {
+  if (median_depth <= 0) return;
+  const auto [entry, inserted] = first_and_last_.try_emplace(map, median_depth, median_depth);
+  if (!inserted) entry->second.second = median_depth;
+}
+
+double MapDepthDrift::Change() const {
+  double change = 0;
+  for (const auto& [map, depths] : first_and_last_) {
+    const double ratio = depths.second / depths.first;
+    if (change == 0 || std::abs(std::log(ratio)) > std::abs(std::log(change))) change = ratio;
+  }
+  return change;
+}
+
+double MedianDepth(const std::vector<DepthPoint>& points) {
+  if (points.empty()) return 0;
+  std::vector<double> depths;
+  depths.reserve(points.size());
+  for (const DepthPoint& point : points) depths.push_back(point.depth);
+  return MedianInPlace(&depths);
+}
+
+std::string DepthChangeText(double map_depth_change) {
+  if (map_depth_change <= 0 ||
+      std::abs(std::log(map_depth_change)) <= std::log(kDepthChangeNoteFactor)) {
+    return "";
+  }
+  std::ostringstream text;
+  text << std::setprecision(2) << "the map's median depth went ×" << map_depth_change
+       << " from its first tracked frame to its last (map units; metrics.csv median_depth): its scale has drifted "
+          "that far unless the scene's depth changed as much";
+  return text.str();
+}
+
 std::vector<std::string> InputEffects::Notes() const {
   std::vector<std::string> notes;
   for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
@@ -120,6 +156,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
+  const std::string depth_change = DepthChangeText(summary.map_depth_change);
+  if (!depth_change.empty()) text << '\n' << depth_change;
   for (const std::string& note : summary.input.Notes()) {
     text << '\n' << note;
   }
@@ -217,7 +255,10 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"births_evaluated", summary.births.births_evaluated},
                       {"birth_log_error_mean", summary.births.mean ? nlohmann::json(*summary.births.mean) : nlohmann::json()},
                       {"birth_log_error_median", summary.births.median ? nlohmann::json(*summary.births.median) : nlohmann::json()},
-                      {"map_points", summary.map_points}};
+                      {"map_points", summary.map_points},
+                      // null when nothing was tracked
+                      {"map_depth_change",
+                       summary.map_depth_change > 0 ? nlohmann::json(summary.map_depth_change) : nlohmann::json()}};
   json.update(nlohmann::json(summary.input));
   json.update(provenance);
   json["status"] = summary.Status();

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,7 +23,7 @@ inline constexpr const char* kPointsCsvHeader = "frame,point_id,u,v,z_est,x,y,z,
 inline constexpr const char* kMetricsCsvHeader =
     "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,"
     "deformable_candidates,new_points,points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,"
-    "ms_dba,ms_triangulation,ms_total,ms_joint_solve,ms_linear_solve,note";
+    "ms_dba,ms_triangulation,ms_total,ms_joint_solve,ms_linear_solve,median_depth,note";
 
 // What the input did to a run, as the runner counts it in summary.json and the batch reads it
 // back into results.json: files that could not be read, frames skipped or noted, ground truth
@@ -60,6 +61,29 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InputEffects, frames_unreadable,
                                                 frames_unreadable_after_init, frames_sparse_groundtruth,
                                                 frames_dropout, sudden_occlusions, view_jumps, static_fraction)
 
+// How far a run's maps' depth wandered in their own units, which needs no ground truth: the
+// median depth of the points a frame reports (its metrics.csv median_depth), at a map's last
+// tracked frame over its first. A monocular map whose scale collapses (docs/mapping.md, "Long
+// runs") shows it as a depth that falls by orders of magnitude, where the depth of a scene seen
+// down a lumen or across a cavity stays within a few times.
+class MapDepthDrift {
+ public:
+  // `median_depth` of a tracked frame of `map`, frames in order; 0 (no point reported) is passed over.
+  void AddFrame(int map, double median_depth);
+  // Of the map whose depth changed most (largest |log|), last over first; 0 when no map had a frame.
+  double Change() const;
+
+ private:
+  std::map<int, std::pair<double, double>> first_and_last_;  // per map
+};
+
+// The median depth of a frame's reported points (map units); 0 when there are none.
+double MedianDepth(const std::vector<DepthPoint>& points);
+
+// A change of a map's median depth beyond this factor, either way, gets a note: more than the
+// depth of an endoscopic scene changes over a sequence, less than a collapsing scale gives.
+inline constexpr double kDepthChangeNoteFactor = 10;
+
 struct RunSummary {
   double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
   double rmse_flat_mm = 0;  // the same points all at one depth (eval/depth_evaluation.h)
@@ -82,6 +106,7 @@ struct RunSummary {
   BirthErrorSummary births;          // how far from the map's scale new points were born
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
+  double map_depth_change = 0;  // MapDepthDrift::Change(): 0 when nothing was tracked
   // A run that ends without tracking: the first frame of that final stretch and its note (why
   // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.
   int stop_frame = -1;
@@ -115,6 +140,10 @@ std::string OcclusionText(int sudden_occlusions);
 // "1 jump of the view: its tracks moved far more than over the frames before (frames missing
 // from the recording, or a jerk of the scope; metrics.csv notes them)"; "" when none.
 std::string ViewJumpText(int view_jumps);
+
+// "the map's median depth went ×3.1e-05 from its first tracked frame to its last (…)" when
+// `map_depth_change` is beyond kDepthChangeNoteFactor either way; "" otherwise (0: none).
+std::string DepthChangeText(double map_depth_change);
 
 // "9.9 % of the image never changed (an on-screen display, a black border or background) and
 // was left out (static_mask.png)"; "" when none.

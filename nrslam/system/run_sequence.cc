@@ -171,6 +171,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   int64_t map_points = 0;  // points of the current map, as of the last frame tracked
   int map_start_frame = -1;  // the frame the current map started on: its points are not births
   BirthErrors births;
+  MapDepthDrift depth_drift;
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
@@ -276,6 +277,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     ms_triangulation += mapping.ms_triangulation;
     FrameEvaluation evaluation;
     std::vector<DepthPoint> depth_points;
+    double median_depth = 0;
     const bool tracked = result.state == TrackingState::kTracking;
     if (tracked && !depth_problem.empty()) {
       // Tracked as if it were whole: only its score is missing, and the run says so.
@@ -303,6 +305,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                    << world.x() << ',' << world.y() << ',' << world.z() << ','
                    << (point.reassociated ? "reassociated" : "tracked") << '\n';
       }
+      median_depth = MedianDepth(depth_points);
+      depth_drift.AddFrame(maps, median_depth);
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         evaluation.map = maps;
@@ -329,7 +333,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                 << (evaluation.evaluated ? std::to_string(evaluation.flat_rmse_mm) : std::string()) << ','
                 << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
                 << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation << ','
-                << result.ms_joint_solve << ',' << result.ms_linear_solve << ',' << CsvField(result.note) << '\n';
+                << result.ms_joint_solve << ',' << result.ms_linear_solve << ',';
+    if (median_depth > 0) metrics_csv << median_depth;  // at the file's 9 digits: a collapsed map's are tiny
+    metrics_csv << ',' << CsvField(result.note) << '\n';
     // A full disk shows here within a few frames, not after the whole run.
     if (points_csv.fail() || metrics_csv.fail()) {
       throw Error("cannot write the run's files in " + out.string() + " (is the disk full?)");
@@ -356,6 +362,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.ms_triangulation = ms_triangulation / summary.frames_total;
   summary.maps = maps;
   summary.map_points = tracker.map().size();
+  summary.map_depth_change = depth_drift.Change();
   AggregateInto(&summary, evaluations, aligned_maps, options.evaluation);
   summary.births = births.Summarise();
 
