@@ -433,10 +433,10 @@ TEST(Results, CsvNamesTheCodeOfEveryRun) {
   std::getline(csv, first);
   std::getline(csv, second);
   EXPECT_EQ(header.substr(header.rfind(",fps,")),
-            ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,map_depth_change,revision,"
-            "code,error");
+            ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,map_depth_change,"
+            "map_depth_change_beyond_from,revision,code,error");
   EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
-  EXPECT_EQ(second.substr(second.find(",,,,\"")), ",,,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
+  EXPECT_EQ(second.substr(second.find(",,,,,\"")), ",,,,,\"cannot read rgb/000003.png, corrupt\"");  // not recorded: empty
   std::filesystem::remove_all(folder);
 }
 
@@ -465,31 +465,36 @@ TEST(Results, BirthErrorsRoundTripAndStayEmptyWhereNoneWasScored) {
   std::filesystem::remove_all(folder);
 }
 
-// A map whose depth fell a thousandfold is noted wherever the run's notes go; one that moved
+// A map whose depth fell a millionfold is noted wherever the run's notes go; one that moved
 // within kDepthChangeNoteFactor, or did not record it, is not.
 TEST(Results, MapDepthChangeRoundTripsAndAFarOneIsNoted) {
   const auto folder = UniqueTempFolder("results_depth_change");
   RunResult collapsed = Result("a", 1.5, 60);
-  collapsed.map_depth_change = 0.001;
+  collapsed.map_depth = {1.5e-6, 187};
   RunResult steady = Result("b", 1.0, 60);
-  steady.map_depth_change = 0.2;
+  steady.map_depth = {0.2, -1};
   const RunResult older = Result("c", 1.0, 60);
   WriteResults({collapsed, steady, older}, folder);
   const std::vector<RunResult> read = ReadResults(folder);
   ASSERT_EQ(read.size(), 3u);
-  EXPECT_EQ(read[0].map_depth_change, std::optional<double>(0.001));
-  EXPECT_EQ(read[1].map_depth_change, std::optional<double>(0.2));
-  EXPECT_FALSE(read[2].map_depth_change);
+  EXPECT_EQ(read[0].map_depth.ratio, 1.5e-6);
+  EXPECT_EQ(read[0].map_depth.beyond_from, 187);
+  EXPECT_EQ(read[1].map_depth.ratio, 0.2);
+  EXPECT_EQ(read[1].map_depth.beyond_from, -1);
+  EXPECT_EQ(read[2].map_depth.ratio, 0.0);
   const std::vector<std::string> notes = RunNotes(read[0]);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_EQ(notes[0].find("the map's median depth went ×0.001 from its first tracked frame to its last"), 0u) << notes[0];
+  EXPECT_EQ(notes[0].find("the map's median depth went ×1.5e-06 from its first tracked frame to its last, beyond 10× "
+                          "from frame 187 on"),
+            0u)
+      << notes[0];
   EXPECT_TRUE(RunNotes(read[1]).empty());
   EXPECT_TRUE(RunNotes(read[2]).empty());
   std::ifstream csv(folder / "results.csv");
   std::string header, first;
   std::getline(csv, header);
   std::getline(csv, first);
-  EXPECT_NE(first.find(",0.001,"), std::string::npos) << first;
+  EXPECT_NE(first.find(",1.5e-06,187,"), std::string::npos) << first;
   std::filesystem::remove_all(folder);
 }
 

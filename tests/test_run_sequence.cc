@@ -229,29 +229,38 @@ TEST_F(RunSequenceTest, MedianDepthIsRecomputableFromPointsCsvAndFollowsTheTruth
   nlohmann::json summary;
   std::ifstream(*base_ / "run" / "summary.json") >> summary;
   EXPECT_NEAR(summary.at("map_depth_change").get<double>(), recorded.at(39) / recorded.at(0), 1e-6);
-  EXPECT_EQ(DepthChangeText(summary.at("map_depth_change").get<double>()), "");
+  EXPECT_TRUE(summary.at("map_depth_change_beyond_from").is_null());
+  EXPECT_EQ(summary_->map_depth.Note(), "");
 }
 
 TEST(MapDepthDrift, IsTheChangeOfTheMapThatMovedMost) {
   MapDepthDrift drift;
-  EXPECT_EQ(drift.Change(), 0.0);
-  drift.AddFrame(1, 2.0);
-  drift.AddFrame(1, 0.0);  // no point reported: passed over
-  drift.AddFrame(1, 1.0);  // map 1: ×0.5
-  drift.AddFrame(2, 1.0);
-  drift.AddFrame(2, 5.0);
-  drift.AddFrame(2, 3.0);  // map 2: ×3, its last over its first, not its largest
-  EXPECT_DOUBLE_EQ(drift.Change(), 3.0);
-  drift.AddFrame(3, 100.0);
-  drift.AddFrame(3, 0.01);  // map 3: ×1e-4, the largest change either way
-  EXPECT_DOUBLE_EQ(drift.Change(), 1e-4);
+  EXPECT_EQ(drift.Change().ratio, 0.0);
+  EXPECT_EQ(drift.Change().Note(), "");
+  drift.AddFrame(1, 0, 2.0);
+  drift.AddFrame(1, 1, 0.0);  // no point reported: passed over
+  drift.AddFrame(1, 2, 1.0);  // map 1: ×0.5
+  drift.AddFrame(2, 3, 1.0);
+  drift.AddFrame(2, 4, 50.0);  // beyond 10×, then back within it
+  drift.AddFrame(2, 5, 3.0);   // map 2: ×3, its last over its first, not its largest
+  EXPECT_DOUBLE_EQ(drift.Change().ratio, 3.0);
+  EXPECT_EQ(drift.Change().beyond_from, -1);
+  EXPECT_EQ(drift.Change().Note(), "");
+  drift.AddFrame(3, 6, 100.0);
+  drift.AddFrame(3, 7, 5.0);   // beyond
+  drift.AddFrame(3, 8, 20.0);  // back within
+  drift.AddFrame(3, 9, 1.0);   // beyond again, from here on
+  drift.AddFrame(3, 10, 0.01);  // map 3: ×1e-4, the largest change either way
+  const DepthChange most = drift.Change();
+  EXPECT_DOUBLE_EQ(most.ratio, 1e-4);
+  EXPECT_EQ(most.beyond_from, 9);
+  EXPECT_EQ(most.Note().find("the map's median depth went ×0.0001 from its first tracked frame to its last, beyond "
+                             "10× from frame 9 on"),
+            0u)
+      << most.Note();
+  EXPECT_EQ((DepthChange{25, 3}.Note().find("the map's median depth went ×25 from")), 0u);
   EXPECT_EQ(MedianDepth({}), 0.0);
   EXPECT_EQ(MedianDepth({{{0, 0}, 3.0}, {{1, 1}, 1.0}, {{2, 2}, 2.0}}), 2.0);
-  EXPECT_EQ(DepthChangeText(0), "");
-  EXPECT_EQ(DepthChangeText(0.11), "");
-  EXPECT_EQ(DepthChangeText(9.5), "");
-  EXPECT_EQ(DepthChangeText(1e-4).find("the map's median depth went ×0.0001 from its first tracked frame"), 0u);
-  EXPECT_EQ(DepthChangeText(25).find("the map's median depth went ×25 from"), 0u);
 }
 
 TEST_F(RunSequenceTest, TrajectoryErrorIsRecomputableFromTheTumFilesAndSmall) {
@@ -296,7 +305,7 @@ TEST_F(RunSequenceTest, ScoringTheRunsOwnOutputAsAnExternalResultGivesItsSummary
   EXPECT_NEAR(summary.rmse_flat_mm, summary_->rmse_flat_mm, 1e-5);
   EXPECT_NEAR(summary.rmse_map_scale_mm, summary_->rmse_map_scale_mm, 1e-5);
   EXPECT_NEAR(summary.rmse_median_scale_mm, summary_->rmse_median_scale_mm, 1e-5);
-  EXPECT_NEAR(summary.map_depth_change, summary_->map_depth_change, 1e-7);
+  EXPECT_NEAR(summary.map_depth.ratio, summary_->map_depth.ratio, 1e-7);
   ASSERT_TRUE(summary.trajectory_error.evaluated);
   EXPECT_NEAR(summary.trajectory_error.rmse_mm, summary_->trajectory_error.rmse_mm, 1e-4);
   for (const char* file : {"config.json", "points.csv", "metrics.csv", "summary.json", "trajectory.tum"}) {

@@ -49,7 +49,8 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->births_evaluated = json.value("births_evaluated", 0);
   result->birth_log_error_mean = OptionalNumber(json, "birth_log_error_mean");
   result->birth_log_error_median = OptionalNumber(json, "birth_log_error_median");
-  result->map_depth_change = OptionalNumber(json, "map_depth_change");
+  result->map_depth.ratio = NumberOr(json, "map_depth_change", 0.0);
+  result->map_depth.beyond_from = static_cast<int>(NumberOr(json, "map_depth_change_beyond_from", -1.0));
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
     result->stop_reason = reason->get<std::string>();
@@ -202,7 +203,7 @@ std::string StopText(const RunResult& result) {
 
 std::vector<std::string> RunNotes(const RunResult& result) {
   std::vector<std::string> notes = result.input.Notes();
-  const std::string depth_change = DepthChangeText(result.map_depth_change.value_or(0));
+  const std::string depth_change = result.map_depth.Note();
   if (!depth_change.empty()) notes.insert(notes.begin(), depth_change);
   const std::string stop = StopText(result);
   if (!stop.empty()) notes.insert(notes.begin(), stop);
@@ -305,7 +306,9 @@ Json ToJson(const std::vector<RunResult>& results) {
              {"births_evaluated", r.births_evaluated},
              {"birth_log_error_mean", RecordedNumber(r.birth_log_error_mean)},
              {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)},
-             {"map_depth_change", RecordedNumber(r.map_depth_change)}, {"run_folder", r.run_folder},
+             {"map_depth_change", r.map_depth.ratio > 0 ? Json(r.map_depth.ratio) : Json()},
+             {"map_depth_change_beyond_from", r.map_depth.beyond_from >= 0 ? Json(r.map_depth.beyond_from) : Json()},
+             {"run_folder", r.run_folder},
              {"revision", r.revision.empty() ? Json() : Json(r.revision)},
              {"code", r.code.empty() ? Json() : Json(r.code)},
              {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
@@ -443,7 +446,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
          "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
          "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
          "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
-         "birth_log_error_median,map_depth_change,revision,code,error\n";
+         "birth_log_error_median,map_depth_change,map_depth_change_beyond_from,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
@@ -455,8 +458,9 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
-        << ',' << RecordedField(r.birth_log_error_median) << ',' << RecordedField(r.map_depth_change) << ','
-        << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
+        << ',' << RecordedField(r.birth_log_error_median) << ','
+        << RecordedField(r.map_depth.ratio > 0 ? std::optional<double>(r.map_depth.ratio) : std::nullopt) << ','
+        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
   WriteTextFile(folder / "results.csv", csv.str());
 }

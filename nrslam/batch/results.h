@@ -34,9 +34,7 @@ struct RunResult {
   // scored, and the mean and median of their log depth errors (none: no birth scored).
   int births_evaluated = 0;
   std::optional<double> birth_log_error_mean, birth_log_error_median;
-  // Of the map whose median depth (map units) changed most, last tracked frame over first
-  // (system/run_files.h, MapDepthDrift); none: not recorded or nothing tracked.
-  std::optional<double> map_depth_change;
+  DepthChange map_depth;  // how far the map that moved most drifted in depth (RunSummary)
   std::string run_folder;
   std::string revision;             // the code that made the run (its config.json); "" when not recorded
   std::string code;                 // that code's fingerprint (CodeFingerprint()); "" when not recorded

@@ -262,7 +262,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
       std::vector<DepthPoint> depth_points;
       for (const EstimatedPoint& point : points) depth_points.push_back({point.pixel, point.depth});
       median_depth = MedianDepth(depth_points);
-      depth_drift.AddFrame(summary.maps, median_depth);
+      depth_drift.AddFrame(summary.maps, frame, median_depth);
       cv::Mat depth_mm;
       if (reader.has_depth() && !points.empty()) {
         depth_mm = reader.TryReadDepthMm(frame, &depth_problem);
@@ -319,7 +319,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   }
   AggregateInto(&summary, evaluations, aligned, evaluation);
   summary.births = births.Summarise();
-  summary.map_depth_change = depth_drift.Change();
+  summary.map_depth = depth_drift.Change();
   CloseWritten(points_csv, out / "points.csv");
   CloseWritten(metrics_csv, out / "metrics.csv");
   WriteTum(out / "trajectory.tum", trajectory);

@@ -69,19 +69,36 @@ std::string StaticRegionText(double static_fraction) {
   return text.str();
 }
 
-void MapDepthDrift::AddFrame(int map, double median_depth) {
-  if (median_depth <= 0) return;
-  const auto [entry, inserted] = first_and_last_.try_emplace(map, median_depth, median_depth);
-  if (!inserted) entry->second.second = median_depth;
+std::string DepthChange::Note() const {
+  if (beyond_from < 0) return "";
+  std::ostringstream text;
+  text << std::setprecision(2) << "the map's median depth went ×" << ratio
+       << " from its first tracked frame to its last, beyond " << kDepthChangeNoteFactor << "× from frame "
+       << beyond_from
+       << " on (map units; metrics.csv median_depth): its scale has drifted that far unless the scene's depth "
+          "changed as much";
+  return text.str();
 }
 
-double MapDepthDrift::Change() const {
-  double change = 0;
-  for (const auto& [map, depths] : first_and_last_) {
-    const double ratio = depths.second / depths.first;
-    if (change == 0 || std::abs(std::log(ratio)) > std::abs(std::log(change))) change = ratio;
+void MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
+  if (median_depth <= 0) return;
+  MapDepths& depths = maps_.try_emplace(map, MapDepths{median_depth, {}}).first->second;
+  depths.change.ratio = median_depth / depths.first;
+  if (std::abs(std::log(depths.change.ratio)) <= std::log(kDepthChangeNoteFactor)) {
+    depths.change.beyond_from = -1;
+  } else if (depths.change.beyond_from < 0) {
+    depths.change.beyond_from = frame;
   }
-  return change;
+}
+
+DepthChange MapDepthDrift::Change() const {
+  DepthChange most;
+  for (const auto& [map, depths] : maps_) {
+    if (most.ratio == 0 || std::abs(std::log(depths.change.ratio)) > std::abs(std::log(most.ratio))) {
+      most = depths.change;
+    }
+  }
+  return most;
 }
 
 double MedianDepth(const std::vector<DepthPoint>& points) {
@@ -92,17 +109,6 @@ double MedianDepth(const std::vector<DepthPoint>& points) {
   return MedianInPlace(&depths);
 }
 
-std::string DepthChangeText(double map_depth_change) {
-  if (map_depth_change <= 0 ||
-      std::abs(std::log(map_depth_change)) <= std::log(kDepthChangeNoteFactor)) {
-    return "";
-  }
-  std::ostringstream text;
-  text << std::setprecision(2) << "the map's median depth went ×" << map_depth_change
-       << " from its first tracked frame to its last (map units; metrics.csv median_depth): its scale has drifted "
-          "that far unless the scene's depth changed as much";
-  return text.str();
-}
 
 std::vector<std::string> InputEffects::Notes() const {
   std::vector<std::string> notes;
@@ -156,7 +162,7 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
-  const std::string depth_change = DepthChangeText(summary.map_depth_change);
+  const std::string depth_change = summary.map_depth.Note();
   if (!depth_change.empty()) text << '\n' << depth_change;
   for (const std::string& note : summary.input.Notes()) {
     text << '\n' << note;
@@ -258,7 +264,10 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"map_points", summary.map_points},
                       // null when nothing was tracked
                       {"map_depth_change",
-                       summary.map_depth_change > 0 ? nlohmann::json(summary.map_depth_change) : nlohmann::json()}};
+                       summary.map_depth.ratio > 0 ? nlohmann::json(summary.map_depth.ratio) : nlohmann::json()},
+                      {"map_depth_change_beyond_from", summary.map_depth.beyond_from >= 0
+                                                           ? nlohmann::json(summary.map_depth.beyond_from)
+                                                           : nlohmann::json()}};
   json.update(nlohmann::json(summary.input));
   json.update(provenance);
   json["status"] = summary.Status();

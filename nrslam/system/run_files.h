@@ -61,28 +61,41 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InputEffects, frames_unreadable,
                                                 frames_unreadable_after_init, frames_sparse_groundtruth,
                                                 frames_dropout, sudden_occlusions, view_jumps, static_fraction)
 
-// How far a run's maps' depth wandered in their own units, which needs no ground truth: the
-// median depth of the points a frame reports (its metrics.csv median_depth), at a map's last
-// tracked frame over its first. A monocular map whose scale collapses (docs/mapping.md, "Long
-// runs") shows it as a depth that falls by orders of magnitude, where the depth of a scene seen
-// down a lumen or across a cavity stays within a few times.
+// A change of a map's median depth beyond this factor, either way, gets a note: more than the
+// depth of an endoscopic scene changes over a sequence, less than a collapsing scale gives.
+inline constexpr double kDepthChangeNoteFactor = 10;
+
+// How far a map's depth moved in its own units, which needs no ground truth: the median depth
+// of the points a frame reports (metrics.csv median_depth) at the map's last tracked frame over
+// its first. A monocular map whose scale collapses (docs/mapping.md, "Long runs") shows it as a
+// depth that falls by orders of magnitude, where the depth of a scene seen down a lumen or
+// across a cavity stays within a few times.
+struct DepthChange {
+  double ratio = 0;      // 0: nothing tracked (or, read back, not recorded)
+  int beyond_from = -1;  // the frame from which it stayed beyond kDepthChangeNoteFactor; -1: it did not
+  // "the map's median depth went ×1.9e-06 from its first tracked frame to its last, beyond 10×
+  // from frame 187 on (…)" when it ends beyond the factor; "" otherwise.
+  std::string Note() const;
+};
+
+// The DepthChange of a run's maps, frame by frame.
 class MapDepthDrift {
  public:
-  // `median_depth` of a tracked frame of `map`, frames in order; 0 (no point reported) is passed over.
-  void AddFrame(int map, double median_depth);
-  // Of the map whose depth changed most (largest |log|), last over first; 0 when no map had a frame.
-  double Change() const;
+  // `median_depth` of tracked `frame` of `map`, frames in order; 0 (no point reported) is passed over.
+  void AddFrame(int map, int frame, double median_depth);
+  // Of the map whose depth changed most (largest |log ratio|).
+  DepthChange Change() const;
 
  private:
-  std::map<int, std::pair<double, double>> first_and_last_;  // per map
+  struct MapDepths {
+    double first = 0;
+    DepthChange change;
+  };
+  std::map<int, MapDepths> maps_;
 };
 
 // The median depth of a frame's reported points (map units); 0 when there are none.
 double MedianDepth(const std::vector<DepthPoint>& points);
-
-// A change of a map's median depth beyond this factor, either way, gets a note: more than the
-// depth of an endoscopic scene changes over a sequence, less than a collapsing scale gives.
-inline constexpr double kDepthChangeNoteFactor = 10;
 
 struct RunSummary {
   double rmse_mm = 0, rmse_median_mm = 0, rmse_pooled_mm = 0;
@@ -106,7 +119,7 @@ struct RunSummary {
   BirthErrorSummary births;          // how far from the map's scale new points were born
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
-  double map_depth_change = 0;  // MapDepthDrift::Change(): 0 when nothing was tracked
+  DepthChange map_depth;  // how far the map that moved most drifted in depth (MapDepthDrift)
   // A run that ends without tracking: the first frame of that final stretch and its note (why
   // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.
   int stop_frame = -1;
@@ -140,10 +153,6 @@ std::string OcclusionText(int sudden_occlusions);
 // "1 jump of the view: its tracks moved far more than over the frames before (frames missing
 // from the recording, or a jerk of the scope; metrics.csv notes them)"; "" when none.
 std::string ViewJumpText(int view_jumps);
-
-// "the map's median depth went ×3.1e-05 from its first tracked frame to its last (…)" when
-// `map_depth_change` is beyond kDepthChangeNoteFactor either way; "" otherwise (0: none).
-std::string DepthChangeText(double map_depth_change);
 
 // "9.9 % of the image never changed (an on-screen display, a black border or background) and
 // was left out (static_mask.png)"; "" when none.

@@ -306,7 +306,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                    << (point.reassociated ? "reassociated" : "tracked") << '\n';
       }
       median_depth = MedianDepth(depth_points);
-      depth_drift.AddFrame(maps, median_depth);
+      depth_drift.AddFrame(maps, frame, median_depth);
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         evaluation.map = maps;
@@ -362,7 +362,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   summary.ms_triangulation = ms_triangulation / summary.frames_total;
   summary.maps = maps;
   summary.map_points = tracker.map().size();
-  summary.map_depth_change = depth_drift.Change();
+  summary.map_depth = depth_drift.Change();
   AggregateInto(&summary, evaluations, aligned_maps, options.evaluation);
   summary.births = births.Summarise();
 
