@@ -460,7 +460,8 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
         << ',' << RecordedField(r.birth_log_error_median) << ','
         << RecordedField(r.map_depth.ratio > 0 ? std::optional<double>(r.map_depth.ratio) : std::nullopt) << ','
-        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
+        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ',' << r.revision << ','
+        << r.code << ',' << CsvField(r.error) << '\n';
   }
   WriteTextFile(folder / "results.csv", csv.str());
 }

@@ -313,7 +313,9 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
                 << ",0,0,0,0,0,0,0,0,";
     if (median_depth > 0) metrics_csv << median_depth;
-    metrics_csv << ',' << CsvField(!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem) << '\n';
+    metrics_csv << ','
+                << CsvField(!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem)
+                << '\n';
     // Last used here, so its pairs move into the list kept for the alignments at the end.
     if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }

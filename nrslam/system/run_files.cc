@@ -81,7 +81,7 @@ std::string DepthChange::Note() const {
 }
 
 void MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
-  if (median_depth <= 0) return;
+  if (!(median_depth > 0)) return;  // NaN too: another system's output may hold anything
   MapDepths& depths = maps_.try_emplace(map, MapDepths{median_depth, {}}).first->second;
   depths.change.ratio = median_depth / depths.first;
   if (std::abs(std::log(depths.change.ratio)) <= std::log(kDepthChangeNoteFactor)) {
@@ -108,7 +108,6 @@ double MedianDepth(const std::vector<DepthPoint>& points) {
   for (const DepthPoint& point : points) depths.push_back(point.depth);
   return MedianInPlace(&depths);
 }
-
 
 std::vector<std::string> InputEffects::Notes() const {
   std::vector<std::string> notes;

@@ -74,14 +74,15 @@ struct DepthChange {
   double ratio = 0;      // 0: nothing tracked (or, read back, not recorded)
   int beyond_from = -1;  // the frame from which it stayed beyond kDepthChangeNoteFactor; -1: it did not
   // "the map's median depth went ×1.9e-06 from its first tracked frame to its last, beyond 10×
-  // from frame 187 on (…)" when it ends beyond the factor; "" otherwise.
+  // from frame 265 on (…)" when it ends beyond the factor; "" otherwise.
   std::string Note() const;
 };
 
 // The DepthChange of a run's maps, frame by frame.
 class MapDepthDrift {
  public:
-  // `median_depth` of tracked `frame` of `map`, frames in order; 0 (no point reported) is passed over.
+  // `median_depth` of tracked `frame` of `map`, frames in order; 0 (no point reported) or NaN is
+  // passed over.
   void AddFrame(int map, int frame, double median_depth);
   // Of the map whose depth changed most (largest |log ratio|).
   DepthChange Change() const;
