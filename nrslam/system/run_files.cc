@@ -80,8 +80,11 @@ std::string DepthChange::Note() const {
   return text.str();
 }
 
-void MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
-  if (!(median_depth > 0)) return;  // NaN too: another system's output may hold anything
+DepthChange MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
+  if (!(median_depth > 0)) {  // NaN too: another system's output may hold anything
+    const auto found = maps_.find(map);
+    return found == maps_.end() ? DepthChange{} : found->second.change;
+  }
   MapDepths& depths = maps_.try_emplace(map, MapDepths{median_depth, {}}).first->second;
   depths.change.ratio = median_depth / depths.first;
   if (std::abs(std::log(depths.change.ratio)) <= std::log(kDepthChangeNoteFactor)) {
@@ -89,6 +92,7 @@ void MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
   } else if (depths.change.beyond_from < 0) {
     depths.change.beyond_from = frame;
   }
+  return depths.change;
 }
 
 DepthChange MapDepthDrift::Change() const {

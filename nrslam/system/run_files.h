@@ -82,8 +82,8 @@ struct DepthChange {
 class MapDepthDrift {
  public:
   // `median_depth` of tracked `frame` of `map`, frames in order; 0 (no point reported) or NaN is
-  // passed over.
-  void AddFrame(int map, int frame, double median_depth);
+  // passed over. Returns `map`'s change so far (ratio 0 before its first depth).
+  DepthChange AddFrame(int map, int frame, double median_depth);
   // Of the map whose depth changed most (largest |log ratio|).
   DepthChange Change() const;
 

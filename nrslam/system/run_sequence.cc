@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <fstream>
 #include <future>
@@ -306,7 +307,16 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                    << (point.reassociated ? "reassociated" : "tracked") << '\n';
       }
       median_depth = MedianDepth(depth_points);
-      depth_drift.AddFrame(maps, frame, median_depth);
+      const DepthChange map_depth = depth_drift.AddFrame(maps, frame, median_depth);
+      const double restart = options.run.restart_on_depth_change;
+      if (monocular && restart > 0 && map_depth.ratio > 0 && std::abs(std::log(map_depth.ratio)) > std::log(restart)) {
+        tracker.GiveUpMap();
+        std::ostringstream given_up;
+        given_up << std::setprecision(3) << "map " << maps << " given up after this frame: its median depth went ×"
+                 << map_depth.ratio << " from its first frame (run.restart_on_depth_change = " << restart << ")";
+        log << "frame " << frame << ": " << given_up.str() << '\n';
+        result.note = result.note.empty() ? given_up.str() : given_up.str() + "; " + result.note;
+      }
       if (!depth_mm.empty()) {
         evaluation = EvaluateFrame(depth_points, depth_mm, options.evaluation);
         evaluation.map = maps;

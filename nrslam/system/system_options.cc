@@ -16,6 +16,9 @@ void RunOptions::Check() const {
   CheckOption(last_frame == -1 || last_frame > first_frame, "run",
               "the frame range [first_frame, last_frame) = [" + std::to_string(first_frame) + ", " +
                   std::to_string(last_frame) + ") is empty (last_frame -1 = to the end)");
+  CheckOption(restart_on_depth_change == 0 || restart_on_depth_change > 1, "run",
+              "restart_on_depth_change must be 0 (never) or a factor above 1, got " +
+                  std::to_string(restart_on_depth_change));
 }
 
 SystemOptions SystemOptionsFromFile(const std::filesystem::path& file) {

@@ -27,10 +27,14 @@ struct RunOptions {
   int first_frame = 0;         // frame range to process, [first_frame, last_frame); -1 = to the end
   int last_frame = -1;
   std::string camera;          // a calibration file (io/camera_file.h) used instead of the sequence's; "" = its own
+  // A monocular map whose median point depth, in its own units, moves beyond this factor from
+  // its first frame either way (system/run_files.h, DepthChange) is given up after that frame
+  // and a new one started from the images, as after a loss: its scale has collapsed. 0 = never.
+  double restart_on_depth_change = 0;
   void Check() const;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunOptions, init, mapping, reinitialise_after_loss, first_frame, last_frame,
-                                                camera)
+                                                camera, restart_on_depth_change)
 
 struct SystemOptions {
   RunOptions run;
