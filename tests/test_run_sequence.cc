@@ -832,6 +832,46 @@ TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
   EXPECT_NEAR(*outcome.summary.births.median, Median(outcome.birth_log_errors), 1e-6);
 }
 
+// run.restart_on_depth_change gives a map up on the first frame its median depth moves beyond
+// the factor, and a new map is started from the images. A factor of 1.2 is far tighter than a
+// real run would take (docs/mapping.md: 10 spares every 120-frame run), so that the 60 frames
+// of sim-3 hold a restart.
+TEST(MonocularRun, AMapWhoseDepthMovesBeyondTheFactorIsGivenUpAndANewOneStarted) {
+  const fs::path folder = UniqueTempFolder("nrslam_monocular_restart");
+  fs::remove_all(folder);
+  SimulateSmall("sim-3", 60, 320, 240, folder / "sequence");
+  SystemOptions options;
+  options.run.restart_on_depth_change = 1.2;
+  const RunSummary summary = RunSequence(folder / "sequence", options, folder / "run");
+  EXPECT_GE(summary.maps, 2);
+  // Each map's frames: within the factor of its first until the one it was given up on.
+  std::map<int, double> first_depth;
+  int given_up = 0, frame_after = -1;
+  for (const auto& row : ReadCsv(folder / "run" / "metrics.csv")) {
+    const int frame = std::stoi(row.at("frame"));
+    if (frame == frame_after) {
+      EXPECT_NE(row.at("state"), "tracking") << "frame " << frame << ": the new map needs frames to start";
+    }
+    if (row.at("state") != "tracking") continue;
+    const int map = std::stoi(row.at("map"));
+    const double depth = std::stod(row.at("median_depth"));
+    const double change = std::abs(std::log(depth / first_depth.emplace(map, depth).first->second));
+    if (row.at("note").find("given up") != std::string::npos) {
+      ++given_up;
+      frame_after = frame + 1;
+      EXPECT_GT(change, std::log(1.2)) << "frame " << frame;
+    } else {
+      EXPECT_LE(change, std::log(1.2)) << "frame " << frame;
+    }
+  }
+  EXPECT_EQ(CountLines(folder / "run" / "run.log", "given up after this frame"), given_up);
+  // Every map but the last was given up; the last one too if the run ended before another began.
+  EXPECT_EQ(given_up, summary.Status() == "ok" ? summary.maps - 1 : summary.maps);
+  EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"run.restart_on_depth_change=1"}), Error);
+  EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"run.restart_on_depth_change=-2"}), Error);
+  fs::remove_all(folder);
+}
+
 TEST(MonocularRun, ShortestGateSpanAdmitsMoreDeformablePoints) {
   // Over a track's oldest and newest observations a deforming surface has moved enough for the
   // rigid rays to miss; the shortest span with enough parallax lets more candidates through,
