@@ -472,6 +472,7 @@ TEST(Results, MapDepthChangeRoundTripsAndAFarOneIsNoted) {
   const auto folder = UniqueTempFolder("results_depth_change");
   RunResult collapsed = Result("a", 1.5, 60);
   collapsed.map_depth = {1.5e-6, 187};
+  collapsed.maps_given_up = 2;
   RunResult steady = Result("b", 1.0, 60);
   steady.map_depth = {0.2, -1};
   const RunResult older = Result("c", 1.0, 60);
@@ -480,15 +481,18 @@ TEST(Results, MapDepthChangeRoundTripsAndAFarOneIsNoted) {
   ASSERT_EQ(read.size(), 3u);
   EXPECT_EQ(read[0].map_depth.ratio, 1.5e-6);
   EXPECT_EQ(read[0].map_depth.beyond_from, 187);
+  EXPECT_EQ(read[0].maps_given_up, 2);
+  EXPECT_EQ(read[1].maps_given_up, 0);
   EXPECT_EQ(read[1].map_depth.ratio, 0.2);
   EXPECT_EQ(read[1].map_depth.beyond_from, -1);
   EXPECT_EQ(read[2].map_depth.ratio, 0.0);
   const std::vector<std::string> notes = RunNotes(read[0]);
-  ASSERT_EQ(notes.size(), 1u);
-  EXPECT_EQ(notes[0].find("the map's median depth went ×1.5e-06 from its first tracked frame to its last, beyond 10× "
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_EQ(notes[0], GivenUpText(2));
+  EXPECT_EQ(notes[1].find("the map's median depth went ×1.5e-06 from its first tracked frame to its last, beyond 10× "
                           "from frame 187 on"),
             0u)
-      << notes[0];
+      << notes[1];
   EXPECT_TRUE(RunNotes(read[1]).empty());
   EXPECT_TRUE(RunNotes(read[2]).empty());
   std::ifstream csv(folder / "results.csv");

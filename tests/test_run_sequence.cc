@@ -865,6 +865,8 @@ TEST(MonocularRun, AMapWhoseDepthMovesBeyondTheFactorIsGivenUpAndANewOneStarted)
     }
   }
   EXPECT_EQ(CountLines(folder / "run" / "run.log", "given up after this frame"), given_up);
+  EXPECT_EQ(summary.maps_given_up, given_up);
+  EXPECT_NE(DescribeSummary(summary).find(GivenUpText(given_up)), std::string::npos) << DescribeSummary(summary);
   // Every map but the last was given up; the last one too if the run ended before another began.
   EXPECT_EQ(given_up, summary.Status() == "ok" ? summary.maps - 1 : summary.maps);
   EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"run.restart_on_depth_change=1"}), Error);

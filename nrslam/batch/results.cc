@@ -51,6 +51,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->birth_log_error_median = OptionalNumber(json, "birth_log_error_median");
   result->map_depth.ratio = NumberOr(json, "map_depth_change", 0.0);
   result->map_depth.beyond_from = static_cast<int>(NumberOr(json, "map_depth_change_beyond_from", -1.0));
+  result->maps_given_up = json.value("maps_given_up", 0);
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
     result->stop_reason = reason->get<std::string>();
@@ -203,8 +204,9 @@ std::string StopText(const RunResult& result) {
 
 std::vector<std::string> RunNotes(const RunResult& result) {
   std::vector<std::string> notes = result.input.Notes();
-  const std::string depth_change = result.map_depth.Note();
-  if (!depth_change.empty()) notes.insert(notes.begin(), depth_change);
+  for (const std::string& note : {result.map_depth.Note(), GivenUpText(result.maps_given_up)}) {
+    if (!note.empty()) notes.insert(notes.begin(), note);
+  }
   const std::string stop = StopText(result);
   if (!stop.empty()) notes.insert(notes.begin(), stop);
   return notes;
@@ -308,6 +310,7 @@ Json ToJson(const std::vector<RunResult>& results) {
              {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)},
              {"map_depth_change", r.map_depth.ratio > 0 ? Json(r.map_depth.ratio) : Json()},
              {"map_depth_change_beyond_from", r.map_depth.beyond_from >= 0 ? Json(r.map_depth.beyond_from) : Json()},
+             {"maps_given_up", r.maps_given_up},
              {"run_folder", r.run_folder},
              {"revision", r.revision.empty() ? Json() : Json(r.revision)},
              {"code", r.code.empty() ? Json() : Json(r.code)},

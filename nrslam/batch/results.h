@@ -35,6 +35,7 @@ struct RunResult {
   int births_evaluated = 0;
   std::optional<double> birth_log_error_mean, birth_log_error_median;
   DepthChange map_depth;  // how far the map that moved most drifted in depth (RunSummary)
+  int maps_given_up = 0;  // maps ended for their depth change (RunSummary)
   std::string run_folder;
   std::string revision;             // the code that made the run (its config.json); "" when not recorded
   std::string code;                 // that code's fingerprint (CodeFingerprint()); "" when not recorded

@@ -80,6 +80,13 @@ std::string DepthChange::Note() const {
   return text.str();
 }
 
+std::string GivenUpText(int maps_given_up) {
+  if (maps_given_up == 0) return "";
+  return std::to_string(maps_given_up) + (maps_given_up == 1 ? " map given up as its" : " maps given up as their") +
+         " median depth moved beyond run.restart_on_depth_change, and a new one started (run.log names the frames; "
+         "those spent starting a new map count as lost)";
+}
+
 DepthChange MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
   if (!(median_depth > 0)) {  // NaN too: another system's output may hold anything
     const auto found = maps_.find(map);
@@ -165,8 +172,9 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
-  const std::string depth_change = summary.map_depth.Note();
-  if (!depth_change.empty()) text << '\n' << depth_change;
+  for (const std::string& note : {GivenUpText(summary.maps_given_up), summary.map_depth.Note()}) {
+    if (!note.empty()) text << '\n' << note;
+  }
   for (const std::string& note : summary.input.Notes()) {
     text << '\n' << note;
   }
@@ -268,6 +276,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       // null when nothing was tracked
                       {"map_depth_change",
                        summary.map_depth.ratio > 0 ? nlohmann::json(summary.map_depth.ratio) : nlohmann::json()},
+                      {"maps_given_up", summary.maps_given_up},
                       {"map_depth_change_beyond_from", summary.map_depth.beyond_from >= 0
                                                            ? nlohmann::json(summary.map_depth.beyond_from)
                                                            : nlohmann::json()}};

@@ -95,6 +95,9 @@ class MapDepthDrift {
   std::map<int, MapDepths> maps_;
 };
 
+// "2 maps given up as their median depth moved beyond run.restart_on_depth_change (…)"; "" when none.
+std::string GivenUpText(int maps_given_up);
+
 // The median depth of a frame's reported points (map units); 0 when there are none.
 double MedianDepth(const std::vector<DepthPoint>& points);
 
@@ -121,6 +124,7 @@ struct RunSummary {
   int maps = 0;            // maps started (a monocular run starts a new one after a loss)
   size_t map_points = 0;   // points in the last map
   DepthChange map_depth;  // how far the map that moved most drifted in depth (MapDepthDrift)
+  int maps_given_up = 0;  // maps ended for their depth change (RunOptions::restart_on_depth_change)
   // A run that ends without tracking: the first frame of that final stretch and its note (why
   // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.
   int stop_frame = -1;

@@ -311,6 +311,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       const double restart = options.run.restart_on_depth_change;
       if (monocular && restart > 0 && map_depth.ratio > 0 && std::abs(std::log(map_depth.ratio)) > std::log(restart)) {
         tracker.GiveUpMap();
+        ++summary.maps_given_up;
         std::ostringstream given_up;
         given_up << std::setprecision(3) << "map " << maps << " given up after this frame: its median depth went ×"
                  << map_depth.ratio << " from its first frame (run.restart_on_depth_change = " << restart << ")";
