@@ -31,8 +31,8 @@ struct RunOptions {
   // its first frame either way (system/run_files.h, DepthChange) is given up after that frame
   // and a new one started from the images, as after a loss: its scale has collapsed. 0 = never.
   // Not in the paper. 10 leaves every measured 120-frame run as it was (the farthest, a colon
-  // rendering, moves 9.7×) and restarts a deforming colon's map every ~200 frames, which holds
-  // its scale over 1000 (README, "Drift without ground truth").
+  // rendering, moves 9.7×) and restarts a deforming colon's map every ~200 frames, which keeps a
+  // 1000-frame run's camera from drifting away with the scale (README, "A collapsing map is given up").
   double restart_on_depth_change = 10;
   void Check() const;
 };
