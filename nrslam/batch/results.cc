@@ -49,8 +49,7 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->births_evaluated = json.value("births_evaluated", 0);
   result->birth_log_error_mean = OptionalNumber(json, "birth_log_error_mean");
   result->birth_log_error_median = OptionalNumber(json, "birth_log_error_median");
-  result->map_depth.ratio = NumberOr(json, "map_depth_change", 0.0);
-  result->map_depth.beyond_from = static_cast<int>(NumberOr(json, "map_depth_change_beyond_from", -1.0));
+  result->map_depth = json.get<DepthChange>();
   result->maps_given_up = json.value("maps_given_up", 0);
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
@@ -203,12 +202,11 @@ std::string StopText(const RunResult& result) {
 }
 
 std::vector<std::string> RunNotes(const RunResult& result) {
-  std::vector<std::string> notes = result.input.Notes();
-  for (const std::string& note : {result.map_depth.Note(), GivenUpText(result.maps_given_up)}) {
-    if (!note.empty()) notes.insert(notes.begin(), note);
+  std::vector<std::string> notes;
+  for (std::string note : {StopText(result), GivenUpText(result.maps_given_up), result.map_depth.Note()}) {
+    if (!note.empty()) notes.push_back(std::move(note));
   }
-  const std::string stop = StopText(result);
-  if (!stop.empty()) notes.insert(notes.begin(), stop);
+  for (std::string& note : result.input.Notes()) notes.push_back(std::move(note));
   return notes;
 }
 
@@ -308,14 +306,13 @@ Json ToJson(const std::vector<RunResult>& results) {
              {"births_evaluated", r.births_evaluated},
              {"birth_log_error_mean", RecordedNumber(r.birth_log_error_mean)},
              {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)},
-             {"map_depth_change", r.map_depth.ratio > 0 ? Json(r.map_depth.ratio) : Json()},
-             {"map_depth_change_beyond_from", r.map_depth.beyond_from >= 0 ? Json(r.map_depth.beyond_from) : Json()},
              {"maps_given_up", r.maps_given_up},
              {"run_folder", r.run_folder},
              {"revision", r.revision.empty() ? Json() : Json(r.revision)},
              {"code", r.code.empty() ? Json() : Json(r.code)},
              {"stop_frame", r.stop_reason.empty() ? Json() : Json(r.stop_frame)},
              {"stop_reason", r.stop_reason.empty() ? Json() : Json(r.stop_reason)}};
+    row.update(Json(r.map_depth));
     row.update(Json(r.input));
     rows.push_back(std::move(row));
   }

@@ -87,6 +87,21 @@ std::string GivenUpText(int maps_given_up) {
          "those spent starting a new map count as lost)";
 }
 
+void to_json(nlohmann::json& json, const DepthChange& change) {
+  const nlohmann::json none;
+  json = {{"map_depth_change", change.ratio > 0 ? nlohmann::json(change.ratio) : none},
+          {"map_depth_change_beyond_from", change.beyond_from >= 0 ? nlohmann::json(change.beyond_from) : none}};
+}
+
+void from_json(const nlohmann::json& json, DepthChange& change) {
+  const auto number = [&json](const char* key, double none) {
+    const auto found = json.find(key);
+    return found != json.end() && found->is_number() ? found->get<double>() : none;
+  };
+  change.ratio = number("map_depth_change", 0);
+  change.beyond_from = static_cast<int>(number("map_depth_change_beyond_from", -1));
+}
+
 DepthChange MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
   if (!(median_depth > 0)) {  // NaN too: another system's output may hold anything
     const auto found = maps_.find(map);
@@ -94,7 +109,7 @@ DepthChange MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
   }
   MapDepths& depths = maps_.try_emplace(map, MapDepths{median_depth, {}}).first->second;
   depths.change.ratio = median_depth / depths.first;
-  if (std::abs(std::log(depths.change.ratio)) <= std::log(kDepthChangeNoteFactor)) {
+  if (!depths.change.Beyond(kDepthChangeNoteFactor)) {
     depths.change.beyond_from = -1;
   } else if (depths.change.beyond_from < 0) {
     depths.change.beyond_from = frame;
@@ -273,13 +288,8 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"birth_log_error_mean", summary.births.mean ? nlohmann::json(*summary.births.mean) : nlohmann::json()},
                       {"birth_log_error_median", summary.births.median ? nlohmann::json(*summary.births.median) : nlohmann::json()},
                       {"map_points", summary.map_points},
-                      // null when nothing was tracked
-                      {"map_depth_change",
-                       summary.map_depth.ratio > 0 ? nlohmann::json(summary.map_depth.ratio) : nlohmann::json()},
-                      {"maps_given_up", summary.maps_given_up},
-                      {"map_depth_change_beyond_from", summary.map_depth.beyond_from >= 0
-                                                           ? nlohmann::json(summary.map_depth.beyond_from)
-                                                           : nlohmann::json()}};
+                      {"maps_given_up", summary.maps_given_up}};
+  json.update(nlohmann::json(summary.map_depth));
   json.update(nlohmann::json(summary.input));
   json.update(provenance);
   json["status"] = summary.Status();

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -73,10 +74,17 @@ inline constexpr double kDepthChangeNoteFactor = 10;
 struct DepthChange {
   double ratio = 0;      // 0: nothing tracked (or, read back, not recorded)
   int beyond_from = -1;  // the frame from which it stayed beyond kDepthChangeNoteFactor; -1: it did not
+  // Whether the depth moved more than `factor` either way (never before a first depth).
+  bool Beyond(double factor) const { return ratio > 0 && std::abs(std::log(ratio)) > std::log(factor); }
   // "the map's median depth went ×1.9e-06 from its first tracked frame to its last, beyond 10×
   // from frame 265 on (…)" when it ends beyond the factor; "" otherwise.
   std::string Note() const;
 };
+
+// Under flat keys in summary.json and a results.json row, null when not recorded:
+// map_depth_change (ratio) and map_depth_change_beyond_from.
+void to_json(nlohmann::json& json, const DepthChange& change);
+void from_json(const nlohmann::json& json, DepthChange& change);
 
 // The DepthChange of a run's maps, frame by frame.
 class MapDepthDrift {

@@ -309,7 +309,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       median_depth = MedianDepth(depth_points);
       const DepthChange map_depth = depth_drift.AddFrame(maps, frame, median_depth);
       const double restart = options.run.restart_on_depth_change;
-      if (monocular && restart > 0 && map_depth.ratio > 0 && std::abs(std::log(map_depth.ratio)) > std::log(restart)) {
+      if (monocular && restart > 0 && map_depth.Beyond(restart)) {
         tracker.GiveUpMap();
         ++summary.maps_given_up;
         std::ostringstream given_up;
