@@ -148,7 +148,8 @@ std::vector<std::string> InputEffects::Notes() const {
 
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
-  return stop_frame >= 0 ? "lost" : "ok";
+  if (stop_frame >= 0) return "lost";
+  return maps_given_up > 0 ? "restarted" : "ok";
 }
 
 void RunSummary::CountFrame(int frame, bool tracked, const std::string& note) {
@@ -288,7 +289,8 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"birth_log_error_mean", summary.births.mean ? nlohmann::json(*summary.births.mean) : nlohmann::json()},
                       {"birth_log_error_median", summary.births.median ? nlohmann::json(*summary.births.median) : nlohmann::json()},
                       {"map_points", summary.map_points},
-                      {"maps_given_up", summary.maps_given_up}};
+                      {"maps_given_up", summary.maps_given_up},
+                      {"frames_restarting", summary.frames_restarting}};
   json.update(nlohmann::json(summary.map_depth));
   json.update(nlohmann::json(summary.input));
   json.update(provenance);

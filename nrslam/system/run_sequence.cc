@@ -171,6 +171,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   int64_t id_base = 0;
   int64_t map_points = 0;  // points of the current map, as of the last frame tracked
   int map_start_frame = -1;  // the frame the current map started on: its points are not births
+  bool restarting = false;   // a map was given up and no new one has tracked yet
   BirthErrors births;
   MapDepthDrift depth_drift;
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
@@ -202,6 +203,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     MappingReport mapping;
     cv::Mat depth_mm;
     std::string depth_problem;
+    bool unreadable = false;
     try {
       const FrameImages images = io.Take();
       const cv::Mat& bgr = images.bgr;
@@ -267,6 +269,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     } catch (const Error& e) {
       result.state = TrackingState::kLost;  // an unreadable frame: recorded, and the run goes on
       result.note = e.what();
+      unreadable = true;
       ++summary.input.frames_unreadable;
       if (summary.init_frame >= 0) ++summary.input.frames_unreadable_after_init;
       log << "frame " << frame << ": " << e.what() << '\n';
@@ -309,7 +312,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       median_depth = MedianDepth(depth_points);
       const DepthChange map_depth = depth_drift.AddFrame(maps, frame, median_depth);
       const double restart = options.run.restart_on_depth_change;
-      if (monocular && restart > 0 && map_depth.Beyond(restart)) {
+      restarting = monocular && restart > 0 && map_depth.Beyond(restart);
+      if (restarting) {
         tracker.GiveUpMap();
         ++summary.maps_given_up;
         std::ostringstream given_up;
@@ -334,6 +338,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       io.Write(out / "depth" / FrameFileName(frame),
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
     }
+    if (!tracked && !unreadable && restarting) ++summary.frames_restarting;
     summary.CountFrame(frame, tracked, result.note);
     metrics_csv << frame << ',' << ToString(result.state) << ',' << maps << ',' << result.points.size() << ','
                 << result.klt_tracked << ',' << result.candidates.size() << ',' << result.outliers << ','
