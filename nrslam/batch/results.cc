@@ -193,9 +193,9 @@ std::string RmseChangeCounts::ToString() const {
 
 std::string RunStatus(const RunResult& figures) {
   if (figures.init_frame < 0) return "not_initialised";
-  const int input_not_tracked = figures.input.frames_dropout + figures.input.frames_unreadable_after_init;
-  const bool every_frame =
-      figures.init_frame + figures.frames_tracked + input_not_tracked + figures.frames_restarting >= figures.frames_total;
+  const int explained = figures.input.frames_dropout + figures.input.frames_unreadable_after_init +
+                        figures.frames_restarting;  // untracked frames that were not the tracker's failure
+  const bool every_frame = figures.init_frame + figures.frames_tracked + explained >= figures.frames_total;
   if (!every_frame || !figures.stop_reason.empty()) return "lost";
   return figures.maps_given_up > 0 ? "restarted" : "ok";
 }

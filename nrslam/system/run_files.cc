@@ -84,7 +84,7 @@ std::string GivenUpText(int maps_given_up) {
   if (maps_given_up == 0) return "";
   return std::to_string(maps_given_up) + (maps_given_up == 1 ? " map given up as its" : " maps given up as their") +
          " median depth moved beyond run.restart_on_depth_change, and a new one started (run.log names the frames; "
-         "those spent starting a new map count as lost)";
+         "the frames spent starting a new map are untracked, counted as frames_restarting, not as lost)";
 }
 
 void to_json(nlohmann::json& json, const DepthChange& change) {
