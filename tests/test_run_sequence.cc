@@ -1161,6 +1161,8 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   EXPECT_EQ(monocular.frames_total, 2);
   EXPECT_EQ(monocular.Status(), "not_initialised");
   EXPECT_EQ(monocular.stop_reason.rfind("initialising: ", 0), 0u) << monocular.stop_reason;
+  // The sequence has ground truth; the run has nothing to score.
+  EXPECT_NE(DescribeSummary(monocular).find("no frame tracked, no RMSE"), std::string::npos) << DescribeSummary(monocular);
   fs::remove_all(folder);
 }
 

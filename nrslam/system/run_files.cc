@@ -174,6 +174,8 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.frames_evaluated > 0) {
     text << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
          << summary.rmse_flat_mm << " mm; one scale per map " << summary.rmse_map_scale_mm << " mm)  ";
+  } else if (summary.frames_tracked == 0) {
+    text << "no frame tracked, no RMSE  ";
   } else if (summary.input.frames_sparse_groundtruth > 0) {
     text << "no RMSE: the ground truth is too sparse to score any frame  ";
   } else {
