@@ -1166,6 +1166,30 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   fs::remove_all(folder);
 }
 
+// A first frame the map cannot start from says whether the image or its depth fell short: a
+// blank image has no corners, a depth map of holes leaves the corners without depth. The run
+// starts on the next frame.
+TEST(RunSequenceErrors, AFirstFrameWithoutCornersOrDepthSaysWhich) {
+  const fs::path folder = UniqueTempFolder("nrslam_blank_first_frame");
+  fs::remove_all(folder);
+  SimulateSmall("sim-0", 3, 160, 120, folder);
+  const fs::path first_image = folder / "rgb" / FrameFileName(0), first_depth = folder / "depth" / FrameFileName(0);
+  const cv::Mat image = cv::imread(first_image.string()), depth = cv::imread(first_depth.string(), cv::IMREAD_UNCHANGED);
+  ASSERT_TRUE(cv::imwrite(first_image.string(), cv::Mat::zeros(image.size(), image.type())));
+  const RunSummary blank = RunSequence(folder, TrackingExperiment(), folder / "run");
+  EXPECT_EQ(blank.init_frame, 1);
+  const auto blank_rows = ReadCsv(folder / "run" / "metrics.csv");
+  EXPECT_NE(blank_rows.at(0).at("note").find("(0 of 0 corners found)"), std::string::npos) << blank_rows.at(0).at("note");
+
+  ASSERT_TRUE(cv::imwrite(first_image.string(), image));
+  ASSERT_TRUE(cv::imwrite(first_depth.string(), cv::Mat::zeros(depth.size(), depth.type())));
+  const RunSummary holes = RunSequence(folder, TrackingExperiment(), folder / "run");
+  EXPECT_EQ(holes.init_frame, 1);
+  const std::string note = ReadCsv(folder / "run" / "metrics.csv").at(0).at("note");
+  EXPECT_TRUE(std::regex_search(note, std::regex(R"(\(0 of [1-9][0-9]* corners found\))"))) << note;
+  fs::remove_all(folder);
+}
+
 // Frames are read ahead of the tracker and depth maps written behind it (run_sequence.cc): a
 // frame that cannot be read must still be the one recorded as failed, and the run go on.
 std::vector<std::string> FileLines(const fs::path& file) {

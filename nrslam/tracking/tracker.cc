@@ -126,7 +126,8 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
   features.max_features = options_.max_points;
   MapSeed seed;
   std::vector<double> depths;
-  for (const cv::Point2f& corner : DetectCorners(grey, BuildValidityMask(grey, mask, frontend_.masks), {}, features)) {
+  const std::vector<cv::Point2f> corners = DetectCorners(grey, BuildValidityMask(grey, mask, frontend_.masks), {}, features);
+  for (const cv::Point2f& corner : corners) {
     const auto depth = SampleDepth(depth_mm, cv::Point2d(corner.x, corner.y));
     if (!depth) continue;
     const Eigen::Vector3d bearing = camera_.Unproject(Eigen::Vector2d(corner.x, corner.y));
@@ -138,7 +139,9 @@ FrameResult Tracker::InitialiseFromDepth(int frame, const cv::Mat& bgr, const cv
   if (static_cast<int>(depths.size()) < options_.min_points) {
     FrameResult result;
     result.frame = frame;
-    return Lost(result, "too few points with depth to initialise (" + std::to_string(depths.size()) + ")");
+    // Whether the image or its depth fell short tells a blank frame from a hole in the depth map.
+    return Lost(result, "too few points with depth to initialise (" + std::to_string(depths.size()) + " of " +
+                            std::to_string(corners.size()) + " corners found)");
   }
   double mean = 0, squares = 0;
   for (double z : depths) {
