@@ -107,7 +107,9 @@ std::string DescribeRevisions(const std::vector<std::string>& revisions) {
 
 std::string DescribeRevisions(const std::vector<RunResult>& results) {
   std::vector<std::string> revisions;
-  for (const RunResult& r : results) revisions.push_back(r.revision);
+  for (const RunResult& r : results) {
+    if (r.status != "failed") revisions.push_back(r.revision);  // a failed run made nothing to name
+  }
   return DescribeRevisions(revisions);
 }
 
