@@ -434,10 +434,10 @@ TEST(Results, CsvNamesTheCodeOfEveryRun) {
   std::getline(csv, second);
   EXPECT_EQ(header.substr(header.rfind(",fps,")),
             ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,map_depth_change,"
-            "map_depth_change_beyond_from,maps_given_up,frames_restarting,revision,code,error");
+            "map_depth_change_beyond_from,revision,code,error");
   EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
   // Not recorded: empty.
-  EXPECT_EQ(second.substr(second.find(",,,,,0,0,,,\"")), ",,,,,0,0,,,\"cannot read rgb/000003.png, corrupt\"");
+  EXPECT_EQ(second.substr(second.find(",,,,,\"")), ",,,,,\"cannot read rgb/000003.png, corrupt\"");
   std::filesystem::remove_all(folder);
 }
 
@@ -679,8 +679,7 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
 
 // A run is "lost" when it leaves frames after its initialisation untracked, or ends without
 // tracking; frames skipped as image dropouts with the map kept, and unreadable frames, are the
-// input's and do not count. Nor do the frames spent starting a new map after one was given up:
-// such a run is "restarted", and compares like an "ok" one.
+// input's and do not count.
 TEST(Results, StatusFromTheFigures) {
   RunResult r;
   r.frames_total = 120;
@@ -702,19 +701,6 @@ TEST(Results, StatusFromTheFigures) {
   r.stop_frame = 119;
   r.stop_reason = "only 0 of 180 points tracked: skipped as an image dropout, the map kept (1 of at most 5 in a row)";
   EXPECT_EQ(RunStatus(r), "lost");  // skipped at the end: the run ends without tracking
-  r.input.frames_dropout = 0;
-  r.stop_frame = -1;
-  r.stop_reason.clear();
-  r.frames_tracked = 113;
-  r.maps_given_up = 1;
-  EXPECT_EQ(RunStatus(r), "lost");  // a map given up, and 4 frames untracked the figures do not explain
-  r.frames_restarting = 3;
-  EXPECT_EQ(RunStatus(r), "lost");  // the restart took 3 of them: 1 was the tracker's
-  r.frames_restarting = 4;
-  EXPECT_EQ(RunStatus(r), "restarted");
-  r.status = RunStatus(r);
-  r.frames_evaluated = 113;
-  EXPECT_TRUE(r.complete());
 }
 
 // One run of a (k, D) sweep grid, evaluated on 100 frames.

@@ -234,7 +234,7 @@ std::string SweepSection(const std::vector<RunResult>& results) {
   // option → sequence → value → (sum, n): each point averages over the other options' values.
   std::map<std::string, std::map<std::string, std::map<double, std::pair<double, int>>>> curves;
   for (const RunResult& r : results) {
-    if (!r.complete()) continue;
+    if (r.status != "ok" || !r.evaluated()) continue;
     for (const std::string& assignment : r.point) {
       const std::optional<double> value = NumericValue(assignment);
       if (!value) continue;  // no axis to plot it on

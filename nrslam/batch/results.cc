@@ -51,7 +51,6 @@ void ReadFigures(const Json& json, RunResult* result) {
   result->birth_log_error_median = OptionalNumber(json, "birth_log_error_median");
   result->map_depth = json.get<DepthChange>();
   result->maps_given_up = json.value("maps_given_up", 0);
-  result->frames_restarting = json.value("frames_restarting", 0);
   const auto reason = json.find("stop_reason");
   if (reason != json.end() && reason->is_string()) {
     result->stop_reason = reason->get<std::string>();
@@ -195,11 +194,9 @@ std::string RmseChangeCounts::ToString() const {
 
 std::string RunStatus(const RunResult& figures) {
   if (figures.init_frame < 0) return "not_initialised";
-  const int explained = figures.input.frames_dropout + figures.input.frames_unreadable_after_init +
-                        figures.frames_restarting;  // untracked frames that were not the tracker's failure
-  const bool every_frame = figures.init_frame + figures.frames_tracked + explained >= figures.frames_total;
-  if (!every_frame || !figures.stop_reason.empty()) return "lost";
-  return figures.maps_given_up > 0 ? "restarted" : "ok";
+  const int input_not_tracked = figures.input.frames_dropout + figures.input.frames_unreadable_after_init;
+  const bool every_frame = figures.init_frame + figures.frames_tracked + input_not_tracked >= figures.frames_total;
+  return every_frame && figures.stop_reason.empty() ? "ok" : "lost";
 }
 
 std::string StopText(const RunResult& result) {
@@ -312,7 +309,6 @@ Json ToJson(const std::vector<RunResult>& results) {
              {"birth_log_error_mean", RecordedNumber(r.birth_log_error_mean)},
              {"birth_log_error_median", RecordedNumber(r.birth_log_error_median)},
              {"maps_given_up", r.maps_given_up},
-             {"frames_restarting", r.frames_restarting},
              {"run_folder", r.run_folder},
              {"revision", r.revision.empty() ? Json() : Json(r.revision)},
              {"code", r.code.empty() ? Json() : Json(r.code)},
@@ -452,8 +448,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
          "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
          "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
          "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
-         "birth_log_error_median,map_depth_change,map_depth_change_beyond_from,maps_given_up,frames_restarting,"
-         "revision,code,error\n";
+         "birth_log_error_median,map_depth_change,map_depth_change_beyond_from,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
@@ -467,9 +462,8 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
         << ',' << RecordedField(r.birth_log_error_median) << ','
         << RecordedField(r.map_depth.ratio > 0 ? std::optional<double>(r.map_depth.ratio) : std::nullopt) << ','
-        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ','
-        << r.maps_given_up << ',' << r.frames_restarting << ',' << r.revision << ',' << r.code << ','
-        << CsvField(r.error) << '\n';
+        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ',' << r.revision << ','
+        << r.code << ',' << CsvField(r.error) << '\n';
   }
   WriteTextFile(folder / "results.csv", csv.str());
 }
@@ -505,7 +499,7 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
     for (const std::string& assignment : r.point) {
       const size_t equals = assignment.find('=');
       Cell& cell = by_value.try_emplace(assignment.substr(0, equals), value_order).first->second[assignment.substr(equals + 1)];
-      if (!r.tracked_to_end()) ++cell.short_runs;
+      if (r.status != "ok") ++cell.short_runs;
       if (!complete.at(r.sequence)) continue;
       cell.rmse.push_back(r.rmse_mm);
       cell.ate.push_back(r.ate_mm);

@@ -18,7 +18,7 @@ struct RunResult {
   std::string sequence;
   std::string label;                // sweep point, "" without sweeps
   std::vector<std::string> point;   // "path=value" per swept option
-  std::string status = "failed";    // "ok", "restarted", "lost", "not_initialised" (RunStatus) or "failed"
+  std::string status = "failed";    // "ok", "lost", "not_initialised" (RunStatus) or "failed"
   std::string error;                // why it failed
   int init_frame = -1, frames_tracked = 0, frames_total = 0;
   int frames_evaluated = 0;         // frames with ground truth; 0: no RMSE (e.g. a plain video)
@@ -36,7 +36,6 @@ struct RunResult {
   std::optional<double> birth_log_error_mean, birth_log_error_median;
   DepthChange map_depth;  // how far the map that moved most drifted in depth (RunSummary)
   int maps_given_up = 0;  // maps ended for their depth change (RunSummary)
-  int frames_restarting = 0;  // frames left untracked after them while a new map started (RunSummary)
   std::string run_folder;
   std::string revision;             // the code that made the run (its config.json); "" when not recorded
   std::string code;                 // that code's fingerprint (CodeFingerprint()); "" when not recorded
@@ -45,10 +44,8 @@ struct RunResult {
   int stop_frame = -1;
   std::string stop_reason;
   bool evaluated() const { return frames_evaluated > 0; }
-  // Every frame after the start tracked, but for the input's and those a deliberate restart took.
-  bool tracked_to_end() const { return status == "ok" || status == "restarted"; }
   // Tracked to the end with ground truth: the runs whose RMSEs compare like with like.
-  bool complete() const { return tracked_to_end() && evaluated(); }
+  bool complete() const { return status == "ok" && evaluated(); }
 };
 
 // How tables and baselines name a run: "sequence", or "sequence [sweep point]".
@@ -87,11 +84,9 @@ struct RmseChangeCounts {
 };
 
 // A finished run's status from its figures: "not_initialised", "lost" (it ends without tracking,
-// or left frames after its initialisation untracked), "restarted" or "ok". Image dropouts skipped
-// with the map kept and unreadable frames do not make it "lost": they are the input's, which
-// every run of the sequence meets. Nor do the frames spent starting a new map after one was
-// given up for its depth change (RunOptions::restart_on_depth_change): the system chose that,
-// and such a run is "restarted", its RMSE as comparable as an "ok" one's.
+// or left frames after its initialisation untracked) or "ok". Image dropouts skipped with the
+// map kept and unreadable frames do not make it "lost": they are the input's, which every run
+// of the sequence meets.
 std::string RunStatus(const RunResult& figures);
 // Where and why a run that ends without tracking stopped: "lost from frame 12: only 7 points
 // left after outlier rejection" or "never initialised: …"; "" when it ends tracking or failed.

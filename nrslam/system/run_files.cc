@@ -83,8 +83,8 @@ std::string DepthChange::Note() const {
 std::string GivenUpText(int maps_given_up) {
   if (maps_given_up == 0) return "";
   return std::to_string(maps_given_up) + (maps_given_up == 1 ? " map given up as its" : " maps given up as their") +
-         " median depth moved beyond run.restart_on_depth_change, and a new one started (run.log names the frames; "
-         "the frames spent starting a new map are untracked, counted as frames_restarting, not as lost)";
+         " median depth moved beyond run.restart_on_depth_change, each replaced by a new one started beside it "
+         "(run.log names the frames)";
 }
 
 void to_json(nlohmann::json& json, const DepthChange& change) {
@@ -148,8 +148,7 @@ std::vector<std::string> InputEffects::Notes() const {
 
 std::string RunSummary::Status() const {
   if (init_frame < 0) return "not_initialised";
-  if (stop_frame >= 0) return "lost";
-  return maps_given_up > 0 ? "restarted" : "ok";
+  return stop_frame >= 0 ? "lost" : "ok";
 }
 
 void RunSummary::CountFrame(int frame, bool tracked, const std::string& note) {
@@ -291,8 +290,7 @@ void WriteSummaryJson(const std::filesystem::path& path, const RunSummary& summa
                       {"birth_log_error_mean", summary.births.mean ? nlohmann::json(*summary.births.mean) : nlohmann::json()},
                       {"birth_log_error_median", summary.births.median ? nlohmann::json(*summary.births.median) : nlohmann::json()},
                       {"map_points", summary.map_points},
-                      {"maps_given_up", summary.maps_given_up},
-                      {"frames_restarting", summary.frames_restarting}};
+                      {"maps_given_up", summary.maps_given_up}};
   json.update(nlohmann::json(summary.map_depth));
   json.update(nlohmann::json(summary.input));
   json.update(provenance);

@@ -133,14 +133,11 @@ struct RunSummary {
   size_t map_points = 0;   // points in the last map
   DepthChange map_depth;  // how far the map that moved most drifted in depth (MapDepthDrift)
   int maps_given_up = 0;  // maps ended for their depth change (RunOptions::restart_on_depth_change)
-  // Frames left untracked after those maps while a new one started (unreadable ones are the input's).
-  int frames_restarting = 0;
   // A run that ends without tracking: the first frame of that final stretch and its note (why
   // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.
   int stop_frame = -1;
   std::string stop_reason;
-  // "lost" (the run ends without tracking), "restarted" (it ends tracking after giving up a
-  // map), "ok" or "not_initialised".
+  // "ok", "lost" (the run ends without tracking) or "not_initialised".
   std::string Status() const;
   // Counts one processed frame, tracked or not (`note`: why not): frames_tracked, frames_lost
   // and where the final untracked stretch began. Set init_frame first on the frame a map starts.

@@ -171,7 +171,9 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   int64_t id_base = 0;
   int64_t map_points = 0;  // points of the current map, as of the last frame tracked
   int map_start_frame = -1;  // the frame the current map started on: its points are not births
-  bool restarting = false;   // a map was given up and no new one has tracked yet
+  // The current map's depth moved beyond run.restart_on_depth_change: the initialiser is
+  // starting a new map from the images while the current one goes on tracking.
+  bool replacing = false;
   BirthErrors births;
   MapDepthDrift depth_drift;
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
@@ -184,6 +186,19 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     map_points = 0;
     map_start_frame = started.frame;
     if (summary.init_frame < 0) summary.init_frame = started.frame;
+  };
+  // Initialises the frame by `attempt` when it succeeded (a monocular start, after a loss or
+  // beside a map being replaced); otherwise leaves `result` alone.
+  const auto start_from_images = [&](int frame, const cv::Mat& bgr, const cv::Mat& mask,
+                                     const InitialisationAttempt& attempt, FrameResult* result) {
+    if (!attempt.success) return;
+    const int replaced = replacing ? maps : 0;
+    *result = tracker.InitialiseFromSeed(frame, bgr, mask, attempt.map.seed);
+    replacing = false;
+    if (result->state != TrackingState::kTracking) return;
+    start_map(*result, ReferenceKeyframe(attempt.map));
+    log << "frame " << frame << ": map " << maps << " initialised from frames " << attempt.map.reference_frame << " and "
+        << frame << (replaced > 0 ? ", replacing map " + std::to_string(replaced) : "") << ": " << attempt.note << "\n";
   };
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
@@ -203,14 +218,21 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     MappingReport mapping;
     cv::Mat depth_mm;
     std::string depth_problem;
-    bool unreadable = false;
     try {
       const FrameImages images = io.Take();
       const cv::Mat& bgr = images.bgr;
       const cv::Mat& mask = images.mask;
       depth_mm = images.depth_mm;
       depth_problem = images.depth_problem;
-      if (tracker.state() == TrackingState::kTracking) {
+      InitialisationAttempt replacement;
+      if (replacing && tracker.state() == TrackingState::kTracking) {
+        const auto init_start = Clock::now();
+        replacement = initialiser.Add(frame, bgr, mask);
+        ms_initialisation += MillisecondsSince(init_start);
+      }
+      if (replacement.success) {
+        start_from_images(frame, bgr, mask, replacement, &result);
+      } else if (tracker.state() == TrackingState::kTracking) {
         result = tracker.Track(frame, bgr, mask, io.PeekNextBgr());
         if (result.state == TrackingState::kLost) {
           summary.input.frames_dropout += result.dropout;
@@ -250,14 +272,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         ms_initialisation += MillisecondsSince(init_start);
         result.state = tracker.state();
         result.note = "initialising: " + attempt.note;
-        if (attempt.success) {
-          result = tracker.InitialiseFromSeed(frame, bgr, mask, attempt.map.seed);
-          if (result.state == TrackingState::kTracking) {
-            start_map(result, ReferenceKeyframe(attempt.map));
-            log << "frame " << frame << ": map " << maps << " initialised from frames " << attempt.map.reference_frame
-                << " and " << frame << ": " << attempt.note << "\n";
-          }
-        }
+        start_from_images(frame, bgr, mask, attempt, &result);
       } else {
         if (!depth_problem.empty()) throw Error(depth_problem);
         result = tracker.InitialiseFromDepth(frame, bgr, depth_mm, mask);
@@ -269,7 +284,6 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
     } catch (const Error& e) {
       result.state = TrackingState::kLost;  // an unreadable frame: recorded, and the run goes on
       result.note = e.what();
-      unreadable = true;
       ++summary.input.frames_unreadable;
       if (summary.init_frame >= 0) ++summary.input.frames_unreadable_after_init;
       log << "frame " << frame << ": " << e.what() << '\n';
@@ -312,13 +326,14 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       median_depth = MedianDepth(depth_points);
       const DepthChange map_depth = depth_drift.AddFrame(maps, frame, median_depth);
       const double restart = options.run.restart_on_depth_change;
-      restarting = monocular && restart > 0 && map_depth.Beyond(restart);
-      if (restarting) {
-        tracker.GiveUpMap();
+      if (monocular && restart > 0 && !replacing && map_depth.Beyond(restart)) {
+        replacing = true;
+        initialiser.Reset();
         ++summary.maps_given_up;
         std::ostringstream given_up;
-        given_up << std::setprecision(3) << "map " << maps << " given up after this frame: its median depth went ×"
-                 << map_depth.ratio << " from its first frame (run.restart_on_depth_change = " << restart << ")";
+        given_up << std::setprecision(3) << "map " << maps << " given up: its median depth went ×" << map_depth.ratio
+                 << " from its first frame (run.restart_on_depth_change = " << restart
+                 << "); it tracks until a new one starts";
         log << "frame " << frame << ": " << given_up.str() << '\n';
         result.note = result.note.empty() ? given_up.str() : given_up.str() + "; " + result.note;
       }
@@ -338,7 +353,6 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       io.Write(out / "depth" / FrameFileName(frame),
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
     }
-    if (!tracked && !unreadable && restarting) ++summary.frames_restarting;
     summary.CountFrame(frame, tracked, result.note);
     metrics_csv << frame << ',' << ToString(result.state) << ',' << maps << ',' << result.points.size() << ','
                 << result.klt_tracked << ',' << result.candidates.size() << ',' << result.outliers << ','

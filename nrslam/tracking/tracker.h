@@ -120,10 +120,6 @@ class Tracker {
   // can come back, so their edges among themselves can go (DeformationGraph::Retire).
   void RetireDroppedPoints(std::vector<PointId> in_use);
 
-  // Ends tracking of the current map, as a loss does: the caller starts a new one.
-  void GiveUpMap() {
-    if (state_ == TrackingState::kTracking) state_ = TrackingState::kLost;
-  }
   TrackingState state() const { return state_; }
   const Rigid3& pose() const { return cam_from_world_; }
   const Map& map() const { return *map_; }
