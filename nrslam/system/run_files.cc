@@ -82,9 +82,10 @@ std::string DepthChange::Note() const {
 
 std::string GivenUpText(int maps_given_up) {
   if (maps_given_up == 0) return "";
-  return std::to_string(maps_given_up) + (maps_given_up == 1 ? " map given up as its" : " maps given up as their") +
-         " median depth moved beyond run.restart_on_depth_change, each replaced by a new one started beside it "
-         "(run.log names the frames)";
+  const bool one = maps_given_up == 1;
+  return std::to_string(maps_given_up) + (one ? " map given up as its" : " maps given up as their") +
+         " median depth moved beyond run.restart_on_depth_change, " + (one ? "" : "each ") +
+         "replaced by a new one started from the images while it tracked on (run.log names the frames)";
 }
 
 void to_json(nlohmann::json& json, const DepthChange& change) {

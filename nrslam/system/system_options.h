@@ -28,11 +28,12 @@ struct RunOptions {
   int last_frame = -1;
   std::string camera;          // a calibration file (io/camera_file.h) used instead of the sequence's; "" = its own
   // A monocular map whose median point depth, in its own units, moves beyond this factor from
-  // its first frame either way (system/run_files.h, DepthChange) is given up after that frame
-  // and a new one started from the images, as after a loss: its scale has collapsed. 0 = never.
+  // its first frame either way (system/run_files.h, DepthChange) is given up: its scale has
+  // collapsed. A new map is started from the images, as after a loss, while the old one tracks
+  // on, and takes over on the frame it starts, so no frame is left untracked. 0 = never.
   // Not in the paper. 10 leaves every measured 120-frame run as it was (the farthest, a colon
   // rendering, moves 9.7×) and restarts a deforming colon's map every ~200 frames, which keeps a
-  // 1000-frame run's camera from drifting away with the scale (README, "A collapsing map is given up").
+  // 1000-frame run's camera from drifting away with the scale (README, "A collapsing map is replaced").
   double restart_on_depth_change = 10;
   void Check() const;
 };
