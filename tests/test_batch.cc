@@ -434,10 +434,10 @@ TEST(Results, CsvNamesTheCodeOfEveryRun) {
   std::getline(csv, second);
   EXPECT_EQ(header.substr(header.rfind(",fps,")),
             ",fps,peak_memory_mb,births_evaluated,birth_log_error_mean,birth_log_error_median,map_depth_change,"
-            "map_depth_change_beyond_from,revision,code,error");
+            "map_depth_change_beyond_from,maps_given_up,revision,code,error");
   EXPECT_EQ(first.substr(first.size() - std::string(",0123456789ab,c0dec0dec0de,").size()), ",0123456789ab,c0dec0dec0de,");
   // Not recorded: empty.
-  EXPECT_EQ(second.substr(second.find(",,,,,\"")), ",,,,,\"cannot read rgb/000003.png, corrupt\"");
+  EXPECT_EQ(second.substr(second.find(",,,,,0,,,\"")), ",,,,,0,,,\"cannot read rgb/000003.png, corrupt\"");
   std::filesystem::remove_all(folder);
 }
 

@@ -448,7 +448,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
          "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
          "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
          "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
-         "birth_log_error_median,map_depth_change,map_depth_change_beyond_from,revision,code,error\n";
+         "birth_log_error_median,map_depth_change,map_depth_change_beyond_from,maps_given_up,revision,code,error\n";
   for (const RunResult& r : results) {
     csv << CsvField(r.sequence) << ',' << CsvField(r.label) << ',' << r.status << ',' << r.init_frame << ','
         << r.frames_tracked << ',' << r.frames_total << ',' << r.frames_evaluated << ','
@@ -462,8 +462,8 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
         << RecordedField(r.peak_memory_mb) << ',' << r.births_evaluated << ',' << RecordedField(r.birth_log_error_mean)
         << ',' << RecordedField(r.birth_log_error_median) << ','
         << RecordedField(r.map_depth.ratio > 0 ? std::optional<double>(r.map_depth.ratio) : std::nullopt) << ','
-        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ',' << r.revision << ','
-        << r.code << ',' << CsvField(r.error) << '\n';
+        << (r.map_depth.beyond_from >= 0 ? std::to_string(r.map_depth.beyond_from) : "") << ',' << r.maps_given_up
+        << ',' << r.revision << ',' << r.code << ',' << CsvField(r.error) << '\n';
   }
   WriteTextFile(folder / "results.csv", csv.str());
 }
