@@ -205,9 +205,8 @@ std::string StopText(const RunResult& result) {
 
 std::vector<std::string> RunNotes(const RunResult& result) {
   std::vector<std::string> notes;
-  for (std::string note : {StopText(result), GivenUpText(result.maps_given_up), result.map_depth.Note()}) {
-    if (!note.empty()) notes.push_back(std::move(note));
-  }
+  if (std::string stop = StopText(result); !stop.empty()) notes.push_back(std::move(stop));
+  for (std::string& note : MapNotes(result.maps_given_up, result.map_depth)) notes.push_back(std::move(note));
   for (std::string& note : result.input.Notes()) notes.push_back(std::move(note));
   return notes;
 }

@@ -88,6 +88,14 @@ std::string GivenUpText(int maps_given_up) {
          "replaced by a new one started from the images while it tracked on (run.log names the frames)";
 }
 
+std::vector<std::string> MapNotes(int maps_given_up, const DepthChange& map_depth) {
+  std::vector<std::string> notes;
+  for (std::string note : {GivenUpText(maps_given_up), map_depth.Note()}) {
+    if (!note.empty()) notes.push_back(std::move(note));
+  }
+  return notes;
+}
+
 void to_json(nlohmann::json& json, const DepthChange& change) {
   const nlohmann::json none;
   json = {{"map_depth_change", change.ratio > 0 ? nlohmann::json(change.ratio) : none},
@@ -190,9 +198,7 @@ std::string DescribeSummary(const RunSummary& summary) {
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
-  for (const std::string& note : {GivenUpText(summary.maps_given_up), summary.map_depth.Note()}) {
-    if (!note.empty()) text << '\n' << note;
-  }
+  for (const std::string& note : MapNotes(summary.maps_given_up, summary.map_depth)) text << '\n' << note;
   for (const std::string& note : summary.input.Notes()) {
     text << '\n' << note;
   }

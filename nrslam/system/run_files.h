@@ -105,6 +105,9 @@ class MapDepthDrift {
 
 // "2 maps given up as their median depth moved beyond run.restart_on_depth_change (…)"; "" when none.
 std::string GivenUpText(int maps_given_up);
+// What a run's maps did, one line each, as nrslam_run and nrslam_eval print it: its GivenUpText
+// and its depth change's Note. Empty when neither has anything to say.
+std::vector<std::string> MapNotes(int maps_given_up, const DepthChange& map_depth);
 
 // The median depth of a frame's reported points (map units); 0 when there are none.
 double MedianDepth(const std::vector<DepthPoint>& points);
@@ -129,7 +132,7 @@ struct RunSummary {
   double ms_tracking_linear_solve = 0;  // of ms_tracking: the joint solves' linear solver
   TrajectoryError trajectory_error;  // camera centres aligned to the ground-truth poses per map
   BirthErrorSummary births;          // how far from the map's scale new points were born
-  int maps = 0;            // maps started (a monocular run starts a new one after a loss)
+  int maps = 0;            // maps started (a monocular run starts a new one after a loss or a give-up)
   size_t map_points = 0;   // points in the last map
   DepthChange map_depth;  // how far the map that moved most drifted in depth (MapDepthDrift)
   int maps_given_up = 0;  // maps ended for their depth change (RunOptions::restart_on_depth_change)

@@ -327,8 +327,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       const DepthChange map_depth = depth_drift.AddFrame(maps, frame, median_depth);
       const double restart = options.run.restart_on_depth_change;
       if (monocular && restart > 0 && !replacing && map_depth.Beyond(restart)) {
-        replacing = true;
-        initialiser.Reset();
+        replacing = true;  // the initialiser's last attempt succeeded, so its next Add starts a reference
         ++summary.maps_given_up;
         std::ostringstream given_up;
         given_up << std::setprecision(3) << "map " << maps << " given up: its median depth went ×" << map_depth.ratio
