@@ -233,7 +233,7 @@ TEST_F(RunSequenceTest, MedianDepthIsRecomputableFromPointsCsvAndFollowsTheTruth
   EXPECT_EQ(summary_->map_depth.Note(), "");
 }
 
-TEST(MapDepthDrift, IsTheChangeOfTheMapThatMovedMost) {
+TEST(MapDepthDrift, IsTheChangeOfTheMapNotGivenUpThatMovedMost) {
   MapDepthDrift drift;
   EXPECT_EQ(drift.Change().ratio, 0.0);
   EXPECT_EQ(drift.Change().Note(), "");
@@ -258,6 +258,19 @@ TEST(MapDepthDrift, IsTheChangeOfTheMapThatMovedMost) {
                              "10× from frame 9 on"),
             0u)
       << most.Note();
+  // A map given up for its depth change has a note of its own (GivenUpText): the change is
+  // then of the maps not given up, and none when every map was.
+  drift.GiveUp(3);
+  EXPECT_DOUBLE_EQ(drift.Change().ratio, 3.0);
+  EXPECT_EQ(drift.Change().Note(), "");
+  drift.GiveUp(1);
+  drift.GiveUp(2);
+  EXPECT_EQ(drift.Change().ratio, 0.0);
+  EXPECT_EQ(drift.Change().beyond_from, -1);
+  drift.GiveUp(7);  // no depth recorded: nothing to give up, and no map made up
+  drift.AddFrame(7, 11, 4.0);
+  drift.AddFrame(7, 12, 2.0);
+  EXPECT_DOUBLE_EQ(drift.Change().ratio, 0.5);
   EXPECT_EQ((DepthChange{25, 3}.Note().find("the map's median depth went ×25 from")), 0u);
   EXPECT_EQ(MedianDepth({}), 0.0);
   EXPECT_EQ(MedianDepth({{{0, 0}, 3.0}, {{1, 1}, 1.0}, {{2, 2}, 2.0}}), 2.0);

@@ -126,9 +126,15 @@ DepthChange MapDepthDrift::AddFrame(int map, int frame, double median_depth) {
   return depths.change;
 }
 
+void MapDepthDrift::GiveUp(int map) {
+  const auto found = maps_.find(map);  // a map is given up only for a depth it has recorded
+  if (found != maps_.end()) found->second.given_up = true;
+}
+
 DepthChange MapDepthDrift::Change() const {
   DepthChange most;
   for (const auto& [map, depths] : maps_) {
+    if (depths.given_up) continue;
     if (most.ratio == 0 || std::abs(std::log(depths.change.ratio)) > std::abs(std::log(most.ratio))) {
       most = depths.change;
     }

@@ -92,13 +92,17 @@ class MapDepthDrift {
   // `median_depth` of tracked `frame` of `map`, frames in order; 0 (no point reported) or NaN is
   // passed over. Returns `map`'s change so far (ratio 0 before its first depth).
   DepthChange AddFrame(int map, int frame, double median_depth);
-  // Of the map whose depth changed most (largest |log ratio|).
+  // `map` was given up for its depth change (RunOptions::restart_on_depth_change); the run says
+  // so in its own note (GivenUpText), so Change() passes it over.
+  void GiveUp(int map);
+  // Of the map not given up whose depth changed most (largest |log ratio|); ratio 0 when none.
   DepthChange Change() const;
 
  private:
   struct MapDepths {
     double first = 0;
     DepthChange change;
+    bool given_up = false;
   };
   std::map<int, MapDepths> maps_;
 };
@@ -134,7 +138,7 @@ struct RunSummary {
   BirthErrorSummary births;          // how far from the map's scale new points were born
   int maps = 0;            // maps started (a monocular run starts a new one after a loss or a give-up)
   size_t map_points = 0;   // points in the last map
-  DepthChange map_depth;  // how far the map that moved most drifted in depth (MapDepthDrift)
+  DepthChange map_depth;  // how far the map not given up that moved most drifted in depth (MapDepthDrift)
   int maps_given_up = 0;  // maps ended for their depth change (RunOptions::restart_on_depth_change)
   // A run that ends without tracking: the first frame of that final stretch and its note (why
   // it was lost); for a run that never initialised, the last frame's note. -1 and "" otherwise.

@@ -329,6 +329,7 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
       if (monocular && restart > 0 && !replacing && map_depth.Beyond(restart)) {
         replacing = true;  // the initialiser's last attempt succeeded, so its next Add starts a reference
         ++summary.maps_given_up;
+        depth_drift.GiveUp(maps);
         std::ostringstream given_up;
         given_up << std::setprecision(3) << "map " << maps << " given up: its median depth went ×" << map_depth.ratio
                  << " from its first frame (run.restart_on_depth_change = " << restart
