@@ -888,7 +888,9 @@ TEST(MonocularRun, AMapWhoseDepthMovesBeyondTheFactorIsReplacedByANewOne) {
   EXPECT_EQ(tracked, summary.frames_total - summary.init_frame);
   EXPECT_EQ(summary.Status(), "ok");
   for (int map : given_up_maps) {
-    if (map < summary.maps) EXPECT_GE(frames_after_given_up[map], 1) << "map " << map;
+    if (map < summary.maps) {
+      EXPECT_GE(frames_after_given_up[map], 1) << "map " << map;
+    }
   }
   EXPECT_EQ(CountLines(folder / "run" / "run.log", "given up: its median depth"), given_up);
   EXPECT_EQ(CountLines(folder / "run" / "run.log", ", replacing map "), summary.maps - 1);
