@@ -859,7 +859,7 @@ TEST(MonocularRun, AMapWhoseDepthMovesBeyondTheFactorIsReplacedByANewOne) {
   EXPECT_GE(summary.maps, 2);
   // Each map's frames: within the factor of its first until the one it was given up on; after
   // that it tracks on, for at least one frame, until the next map starts.
-  std::map<int, double> first_depth;
+  std::map<int, double> first_depth, last_depth;
   std::set<int> given_up_maps;
   std::map<int, int> frames_after_given_up;  // by map
   int tracked = 0;
@@ -876,6 +876,7 @@ TEST(MonocularRun, AMapWhoseDepthMovesBeyondTheFactorIsReplacedByANewOne) {
       continue;
     }
     const double depth = std::stod(row.at("median_depth"));
+    last_depth[map] = depth;
     const double change = std::abs(std::log(depth / first_depth.emplace(map, depth).first->second));
     if (row.at("note").find("given up") != std::string::npos) {
       given_up_maps.insert(map);
@@ -898,6 +899,12 @@ TEST(MonocularRun, AMapWhoseDepthMovesBeyondTheFactorIsReplacedByANewOne) {
   EXPECT_NE(DescribeSummary(summary).find(GivenUpText(given_up)), std::string::npos) << DescribeSummary(summary);
   // Every map but the last was given up; the last one too if the run ended before another began.
   EXPECT_TRUE(given_up == summary.maps - 1 || given_up == summary.maps) << given_up << " of " << summary.maps;
+  // The given-up maps have their note; the drift figure is the last map's, or none.
+  if (given_up == summary.maps) {
+    EXPECT_EQ(summary.map_depth.ratio, 0.0);
+  } else {
+    EXPECT_NEAR(summary.map_depth.ratio, last_depth.at(summary.maps) / first_depth.at(summary.maps), 1e-6);
+  }
   EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"run.restart_on_depth_change=1"}), Error);
   EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"run.restart_on_depth_change=-2"}), Error);
   fs::remove_all(folder);
