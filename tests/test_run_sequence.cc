@@ -557,6 +557,30 @@ TEST_F(RunSequenceTest, RegularisersCanBeAblatedOneByOne) {
   }
 }
 
+// With a cap on the joint solve the points it leaves out move with their solved neighbours
+// (metrics.csv counts them among the propagated) and are still tracked and scored.
+TEST_F(RunSequenceTest, AJointSolveCapLeavesPointsToTheirNeighboursAndStillTracks) {
+  constexpr int kCap = 40;
+  SystemOptions options = TrackingExperiment();
+  options.tracking.joint_solve_max_points = kCap;
+  const RunSummary capped = RunSequence(*base_ / "sequence", options, *base_ / "capped");
+  EXPECT_EQ(capped.frames_tracked, 40);
+  EXPECT_LT(capped.rmse_mm, 2.0);
+  EXPECT_NE(capped.rmse_mm, summary_->rmse_mm);
+  int frames_over_cap = 0;
+  for (const auto& row : ReadCsv(*base_ / "capped" / "metrics.csv")) {
+    if (std::stoi(row.at("frame")) == 0) continue;  // the map's first frame is not tracked
+    const int in_view = std::stoi(row.at("points")) + std::stoi(row.at("outliers"));
+    ASSERT_GT(in_view, kCap) << "frame " << row.at("frame") << ": the cap should bind on every frame";
+    ++frames_over_cap;
+    EXPECT_GE(std::stoi(row.at("propagated")), in_view - std::stoi(row.at("reassociated")) - kCap)
+        << "frame " << row.at("frame");
+    EXPECT_GT(std::stoi(row.at("points")), kCap) << "frame " << row.at("frame");
+  }
+  EXPECT_EQ(frames_over_cap, 39);
+  EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"tracking.joint_solve_max_points=5"}), Error);
+}
+
 TEST(MotionSeed, TheCommonMotionIsRemovedAndTheRestKept) {
   const std::vector<Eigen::Vector3d> relative =
       WithoutCommonMotion({{1.0, 2.0, 3.0}, {3.0, 2.0, 1.0}, {2.0, 5.0, 2.0}});

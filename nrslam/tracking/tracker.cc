@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <utility>
 
 #include "nrslam/camera/reprojection_cost.h"
@@ -557,6 +558,43 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
   return times;
 }
 
+std::vector<size_t> Tracker::JointSolveSubset(const std::vector<Observation>& observations) const {
+  std::vector<size_t> order(observations.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  const auto cap = static_cast<size_t>(options_.joint_solve_max_points);
+  if (cap == 0 || observations.size() <= cap) return order;
+  // Oldest first (ids grow as points are made): the subset changes little from frame to frame.
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return observations[a].id < observations[b].id; });
+  const double cell = std::sqrt(static_cast<double>(camera_.width()) * camera_.height() / static_cast<double>(cap));
+  const int columns = static_cast<int>(std::ceil(camera_.width() / cell));
+  const int rows = static_cast<int>(std::ceil(camera_.height() / cell));
+  std::vector<bool> cell_taken(static_cast<size_t>(columns * rows), false), chosen(observations.size(), false);
+  size_t count = 0;
+  for (size_t i : order) {
+    const int column = std::clamp(static_cast<int>(observations[i].pixel.x() / cell), 0, columns - 1);
+    const int row = std::clamp(static_cast<int>(observations[i].pixel.y() / cell), 0, rows - 1);
+    const auto index = static_cast<size_t>(row * columns + column);
+    if (count < cap && !cell_taken[index]) {
+      cell_taken[index] = chosen[i] = true;
+      ++count;
+    }
+  }
+  // Where the points leave cells empty (a dark lumen), the oldest of the rest fill the budget.
+  for (size_t i : order) {
+    if (count == cap) break;
+    if (!chosen[i]) {
+      chosen[i] = true;
+      ++count;
+    }
+  }
+  std::vector<size_t> solved;
+  for (size_t i = 0; i < observations.size(); ++i) {
+    if (chosen[i]) solved.push_back(i);
+  }
+  return solved;
+}
+
 std::vector<cv::Point2f> Tracker::KltGuesses() const {
   std::vector<cv::Point2f> guesses;
   guesses.reserve(tracks_.size());
@@ -633,35 +671,56 @@ std::optional<std::string> Tracker::SolvePoseAndDeformation(std::vector<Observat
       point_motion_.resize(map_->size());
       for (size_t id = 0; id < point_motion_.size(); ++id) point_motion_[id] = map_->points()[id].position;
     }
-    const JointSolveTimes times = SolveDeformation(observations, motion_seeds, &pose, &displacements, &inliers);
+    const std::vector<size_t> solved = JointSolveSubset(observations);
+    std::vector<Observation> solved_observations;
+    std::vector<Eigen::Vector3d> solved_seeds, solved_displacements;
+    for (size_t i : solved) {
+      solved_observations.push_back(observations[i]);
+      solved_seeds.push_back(motion_seeds[i]);
+    }
+    std::vector<bool> solved_inliers, in_solve(observations.size(), false);
+    const JointSolveTimes times =
+        SolveDeformation(solved_observations, solved_seeds, &pose, &solved_displacements, &solved_inliers);
+    for (size_t k = 0; k < solved.size(); ++k) {
+      in_solve[solved[k]] = true;
+      displacements[solved[k]] = solved_displacements[k];
+      inliers[solved[k]] = solved_inliers[k];
+    }
     result->ms_joint_solve = times.ms_total;
     result->ms_linear_solve = times.ms_linear;
     // Demote points whose displacement is an outlier (IQR fence on ‖δ‖); they keep their position.
-    std::vector<double> norms;
+    std::vector<double> norms, sorted, inlier_norms;
     for (const auto& d : displacements) norms.push_back(d.norm());
-    std::vector<double> sorted = norms;
+    for (size_t i : solved) sorted.push_back(norms[i]);
     std::sort(sorted.begin(), sorted.end());
     const double q1 = sorted[sorted.size() / 4], q3 = sorted[(3 * sorted.size()) / 4];
     const double fence = q3 + options_.displacement_iqr_factor * (q3 - q1);
-    std::vector<double> inlier_norms;
-    for (size_t i = 0; i < observations.size(); ++i) {
+    for (size_t i : solved) {
       if (inliers[i]) inlier_norms.push_back(norms[i]);
     }
     if (!inlier_norms.empty()) result->median_displacement = Median(inlier_norms);
     for (size_t i = 0; i < observations.size(); ++i) {
-      demoted[i] = norms[i] >= fence && norms[i] > 0;
-      if (!demoted[i]) map_->point(observations[i].id).position += displacements[i];
+      demoted[i] = in_solve[i] && norms[i] >= fence && norms[i] > 0;
+      if (in_solve[i] && !demoted[i]) map_->point(observations[i].id).position += displacements[i];
     }
     std::vector<std::optional<Eigen::Vector3d>> optimised(map_->size());
-    std::vector<PointId> demoted_ids, updated_ids;
+    std::vector<PointId> moved_by_neighbours, updated_ids;  // the demoted ones, and those left out of the solve
     for (size_t i = 0; i < observations.size(); ++i) {
-      if (demoted[i]) demoted_ids.push_back(observations[i].id);
-      if (!inliers[i] || demoted[i]) continue;
+      if (demoted[i] || !in_solve[i]) moved_by_neighbours.push_back(observations[i].id);
+      if (!in_solve[i] || !inliers[i] || demoted[i]) continue;
       updated_ids.push_back(observations[i].id);
       optimised[static_cast<size_t>(observations[i].id)] = displacements[i];
     }
     map_->graph().UpdatePoints(updated_ids, map_->Positions());
-    result->propagated = PropagateMotion(optimised, demoted_ids);
+    result->propagated = PropagateMotion(optimised, moved_by_neighbours);
+    // A point left out of the solve is reported where its neighbours took it, if its track agrees.
+    const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (in_solve[i]) continue;
+      inliers[i] = SquaredReprojectionError(camera_, pose, map_->point(observations[i].id).position,
+                                            observations[i].pixel) / sigma2 <=
+                   options_.outlier_chi2;
+    }
     for (size_t id = 0; id < point_motion_.size(); ++id) {
       point_motion_[id] = map_->points()[id].position - point_motion_[id];
     }

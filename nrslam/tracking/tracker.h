@@ -250,6 +250,9 @@ class Tracker {
   JointSolveTimes SolveDeformation(const std::vector<Observation>& observations,
                                    const std::vector<Eigen::Vector3d>& start, Rigid3* pose,
                                    std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
+  // The observations that take part in the joint solve (indices, ascending): all of them, or
+  // with joint_solve_max_points a subset spread over the image, the oldest point of each cell.
+  std::vector<size_t> JointSolveSubset(const std::vector<Observation>& observations) const;
   // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
   // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.
   // `optimised` is indexed by point id (nullopt: not optimised this frame).

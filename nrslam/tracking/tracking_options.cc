@@ -20,6 +20,8 @@ void TrackingOptions::Check() const {
               "joint_linear_solver must be sparse_cholesky or cgnr, got '" + joint_linear_solver + "'");
   CheckOption(joint_trust_region == "levenberg_marquardt" || joint_trust_region == "dogleg", "tracking",
               "joint_trust_region must be levenberg_marquardt or dogleg, got '" + joint_trust_region + "'");
+  CheckOption(joint_solve_max_points == 0 || joint_solve_max_points >= min_points, "tracking",
+              "joint_solve_max_points must be 0 (every point) or >= min_points");
   CheckOption(pose_sigma_px > 0 && outlier_chi2 > 0 && displacement_iqr_factor > 0, "tracking",
               "sigma, chi2 and IQR factor must be > 0");
   CheckOption(displacement_prior_sigma >= 0, "tracking", "displacement_prior_sigma must be >= 0 (0: no prior)");

@@ -50,6 +50,12 @@ struct TrackingOptions {
   // which re-uses a step's linear solve when the region shrinks instead of factorising again:
   // tracking 0–14 % faster, accuracy mixed over the seed renderings (docs/tracking.md).
   std::string joint_trust_region = "levenberg_marquardt";
+  // At most this many points take part in the joint solve, spread over the image (the oldest
+  // in each cell of a grid); the others move with their solved neighbours, as demoted points
+  // do, and stay reported while they reproject within outlier_chi2. The solve's cost grows
+  // faster than its point count, and a map that keeps its points in view (lap-lobes: ~460)
+  // pays most. 0: every point (the reference).
+  int joint_solve_max_points = 0;
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
   double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
   // σ of a zero-mean prior on each point's displacement δ, in map-scale units (0: none, the
@@ -100,6 +106,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrackingOptions, rigid, max_poin
                                                 jump_flow_ratio,
                                                 pose_rounds, pose_iterations, pose_sigma_px, deformation_rounds,
                                                 deformation_iterations, joint_linear_solver, joint_trust_region,
+                                                joint_solve_max_points,
                                                 outlier_chi2, displacement_iqr_factor, displacement_prior_sigma,
                                                 deformation_motion_seed, reassociation, reassociation_levels,
                                                 reassociation_gate_px2, reassociation_consensus_k, hidden_recent_frames,
