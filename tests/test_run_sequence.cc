@@ -567,17 +567,22 @@ TEST_F(RunSequenceTest, AJointSolveCapLeavesPointsToTheirNeighboursAndStillTrack
   EXPECT_EQ(capped.frames_tracked, 40);
   EXPECT_LT(capped.rmse_mm, 2.0);
   EXPECT_NE(capped.rmse_mm, summary_->rmse_mm);
-  int frames_over_cap = 0;
-  for (const auto& row : ReadCsv(*base_ / "capped" / "metrics.csv")) {
-    if (std::stoi(row.at("frame")) == 0) continue;  // the map's first frame is not tracked
-    const int in_view = std::stoi(row.at("points")) + std::stoi(row.at("outliers"));
-    ASSERT_GT(in_view, kCap) << "frame " << row.at("frame") << ": the cap should bind on every frame";
-    ++frames_over_cap;
-    EXPECT_GE(std::stoi(row.at("propagated")), in_view - std::stoi(row.at("reassociated")) - kCap)
-        << "frame " << row.at("frame");
-    EXPECT_GT(std::stoi(row.at("points")), kCap) << "frame " << row.at("frame");
+  const auto propagated = [](const fs::path& run) {
+    std::vector<int> counts;
+    for (const auto& row : ReadCsv(run / "metrics.csv")) counts.push_back(std::stoi(row.at("propagated")));
+    return counts;
+  };
+  const std::vector<int> capped_moves = propagated(*base_ / "capped"), free_moves = propagated(*base_ / "run");
+  ASSERT_EQ(capped_moves.size(), free_moves.size());
+  // On the first tracked frame nothing is lost or demoted yet, and ~200 points are in view:
+  // all but the cap's are left to their neighbours, and they are still reported.
+  const auto first = ReadCsv(*base_ / "capped" / "metrics.csv").at(1);
+  EXPECT_EQ(free_moves.at(1), 0);
+  EXPECT_GT(capped_moves.at(1), 3 * kCap);
+  EXPECT_GT(std::stoi(first.at("points")), 3 * kCap);
+  for (size_t frame = 1; frame < capped_moves.size(); ++frame) {
+    EXPECT_GT(capped_moves[frame], free_moves[frame]) << "frame " << frame;
   }
-  EXPECT_EQ(frames_over_cap, 39);
   EXPECT_THROW(WithRunAssignments(SystemOptions{}, {"tracking.joint_solve_max_points=5"}), Error);
 }
 
