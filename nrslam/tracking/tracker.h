@@ -253,9 +253,10 @@ class Tracker {
   // The observations that take part in the joint solve (indices, ascending): all of them, or
   // with joint_solve_max_points a subset spread over the image, the oldest point of each cell.
   std::vector<size_t> JointSolveSubset(const std::vector<Observation>& observations) const;
-  // Moves each lost or demoted point by the weighted mean displacement (weights b²) of its best
-  // optimised neighbours: the minimiser of its viscous terms with the neighbours held fixed.
-  // `optimised` is indexed by point id (nullopt: not optimised this frame).
+  // Moves each lost point and each of `demoted` (demoted, or left out of the joint solve) by the
+  // weighted mean displacement (weights b²) of its best optimised neighbours: the minimiser of
+  // its viscous terms with the neighbours held fixed. `optimised` is indexed by point id
+  // (nullopt: not optimised this frame).
   int PropagateMotion(const std::vector<std::optional<Eigen::Vector3d>>& optimised,
                       const std::vector<PointId>& demoted);
   // Drops lost points that are too old or that the graph has cut loose.
