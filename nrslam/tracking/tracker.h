@@ -251,7 +251,8 @@ class Tracker {
                                    const std::vector<Eigen::Vector3d>& start, Rigid3* pose,
                                    std::vector<Eigen::Vector3d>* displacements, std::vector<bool>* inliers) const;
   // The observations that take part in the joint solve (indices, ascending): all of them, or
-  // with joint_solve_max_points a subset spread over the image, the oldest point of each cell.
+  // with joint_solve_max_points a subset spread over the image, one point of each cell of a
+  // grid, taken in turn over the frames between keyframes.
   std::vector<size_t> JointSolveSubset(const std::vector<Observation>& observations) const;
   // Moves each lost point and each of `demoted` (demoted, or left out of the joint solve) by the
   // weighted mean displacement (weights b²) of its best optimised neighbours: the minimiser of

@@ -50,11 +50,11 @@ struct TrackingOptions {
   // which re-uses a step's linear solve when the region shrinks instead of factorising again:
   // tracking 0–14 % faster, accuracy mixed over the seed renderings (docs/tracking.md).
   std::string joint_trust_region = "levenberg_marquardt";
-  // At most this many points take part in the joint solve, spread over the image (the oldest
-  // in each cell of a grid); the others move with their solved neighbours, as demoted points
-  // do, and stay reported while they reproject within outlier_chi2. The solve's cost grows
-  // faster than its point count, and a map that keeps its points in view (lap-lobes: ~460)
-  // pays most. 0: every point (the reference).
+  // At most this many points take part in the joint solve, spread over the image (one point
+  // of each cell of a grid, a different one each frame); the others move with their solved
+  // neighbours, as demoted points do, and stay reported while they reproject within
+  // outlier_chi2. The solve's cost grows faster than its point count, and a map that keeps its
+  // points in view (lap-lobes: ~460) pays most. 0: every point (the reference).
   int joint_solve_max_points = 0;
   double outlier_chi2 = 5.99;         // reprojection χ² (2 DoF, 95 %) beyond which a point is an outlier
   double displacement_iqr_factor = 1.5;  // ‖δ‖ ≥ Q3 + factor·IQR demotes a point
