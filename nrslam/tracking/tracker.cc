@@ -413,6 +413,12 @@ bool Tracker::MovedWithItsNeighbours(const FoundAgain& point, const std::vector<
   return from_theirs.dot(from_theirs) <= options_.reassociation_gate_px2;
 }
 
+bool Tracker::ReprojectsWithinChi2(const Rigid3& cam_from_world, const Eigen::Vector3d& world,
+                                   const Eigen::Vector2d& observed, double sigma_px) const {
+  const double sigma2 = sigma_px * sigma_px;
+  return SquaredReprojectionError(camera_, cam_from_world, world, observed) / sigma2 <= options_.outlier_chi2;
+}
+
 std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observations,
                                       const std::vector<Eigen::Vector3d>& start, Rigid3* pose) const {
   const PoseParams seed = pose->ToParams();
@@ -441,9 +447,8 @@ std::vector<bool> Tracker::RefinePose(const std::vector<Observation>& observatio
     ceres::Solver::Summary summary;
     ceres::Solve(SolverOptions(options_.pose_iterations, ceres::DENSE_QR), &problem, &summary);
     const Rigid3 estimate = Rigid3::FromParams(params.data());
-    const double sigma2 = options_.pose_sigma_px * options_.pose_sigma_px;
     for (size_t i = 0; i < observations.size(); ++i) {
-      inliers[i] = SquaredReprojectionError(camera_, estimate, points[i], observations[i].pixel) / sigma2 <= options_.outlier_chi2;
+      inliers[i] = ReprojectsWithinChi2(estimate, points[i], observations[i].pixel, options_.pose_sigma_px);
     }
   }
   *pose = Rigid3::FromParams(params.data());
@@ -483,7 +488,6 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
   // neighbours that really move apart (strong or discontinuous deformation) stop pulling.
   std::vector<bool> viscous_on(pairs.size(), true);
   PoseParams params = rigid;
-  const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
   // The residuals are the same functions in every round (only which ones take part changes):
   // built once, owned here, and lent to each round's problem.
   std::vector<std::unique_ptr<ceres::CostFunction>> reprojection_costs, elastic_costs, viscous_costs;
@@ -543,9 +547,8 @@ Tracker::JointSolveTimes Tracker::SolveDeformation(const std::vector<Observation
     times.ms_linear += 1e3 * summary.linear_solver_time_in_seconds;
     const Rigid3 estimate = Rigid3::FromParams(params.data());
     for (size_t i = 0; i < n; ++i) {
-      (*inliers)[i] = SquaredReprojectionError(camera_, estimate, points[i] + (*displacements)[i], observations[i].pixel) /
-                          sigma2 <=
-                      options_.outlier_chi2;
+      (*inliers)[i] = ReprojectsWithinChi2(estimate, points[i] + (*displacements)[i], observations[i].pixel,
+                                           deformation_.reprojection_sigma_px);
     }
     const double viscous_chi2 = deformation_.huber_deformation * deformation_.huber_deformation;
     for (size_t p = 0; p < pairs.size(); ++p) {
@@ -718,12 +721,10 @@ std::optional<std::string> Tracker::SolvePoseAndDeformation(std::vector<Observat
     map_->graph().UpdatePoints(updated_ids, map_->Positions());
     result->propagated = PropagateMotion(optimised, moved_by_neighbours);
     // A point left out of the solve is reported where its neighbours took it, if its track agrees.
-    const double sigma2 = deformation_.reprojection_sigma_px * deformation_.reprojection_sigma_px;
     for (size_t i = 0; i < observations.size(); ++i) {
       if (in_solve[i]) continue;
-      inliers[i] = SquaredReprojectionError(camera_, pose, map_->point(observations[i].id).position,
-                                            observations[i].pixel) / sigma2 <=
-                   options_.outlier_chi2;
+      inliers[i] = ReprojectsWithinChi2(pose, map_->point(observations[i].id).position, observations[i].pixel,
+                                        deformation_.reprojection_sigma_px);
     }
     for (size_t id = 0; id < point_motion_.size(); ++id) {
       point_motion_[id] = map_->points()[id].position - point_motion_[id];

@@ -237,6 +237,10 @@ class Tracker {
   // that part of the view (an instrument sliding in). A point lost alone, or at the image's
   // edge as the view moves on, is not marked.
   void MarkHiddenLosses(int frame);
+  // The inlier test of every solve: `world` reprojects within outlier_chi2 of `observed`, its
+  // residual whitened by `sigma_px` (infinite, so not, when it does not project).
+  bool ReprojectsWithinChi2(const Rigid3& cam_from_world, const Eigen::Vector3d& world,
+                            const Eigen::Vector2d& observed, double sigma_px) const;
   // Rigid pose-only refinement; returns the per-observation inlier flags of the last round.
   // Each point is moved by its `start` δ (one per observation) before the fit.
   std::vector<bool> RefinePose(const std::vector<Observation>& observations, const std::vector<Eigen::Vector3d>& start,
