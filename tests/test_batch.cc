@@ -418,6 +418,50 @@ TEST(Baseline, PassesOnEqualFailsOnWorseOrMissing) {
   EXPECT_NE(CheckBaseline(later, with_code).report.find("of these runs: fedcba987654 (other code)\n"), std::string::npos);
 }
 
+TEST(Baseline, APooledToleranceCatchesRunsWorseTogetherThatEachPassAlone) {
+  const std::vector<RunResult> before = {Result("a", 1.0, 60), Result("b", 2.0, 60), Result("c", 4.0, 60),
+                                         Result("d", 8.0, 60)};
+  BaselineTolerance loose;
+  loose.rmse_relative = 0.5;
+  loose.pooled_rmse_relative = 0.1;
+  const Json baseline = MakeBaseline(before, loose);
+  EXPECT_EQ(baseline["tolerance"]["pooled_rmse_relative"], 0.1);
+  // Every run 20 % worse: each within its 50 %, together beyond 10 %.
+  std::vector<RunResult> worse = before;
+  for (RunResult& r : worse) r.rmse_mm *= 1.2;
+  const BaselineCheck together = CheckBaseline(worse, baseline);
+  EXPECT_FALSE(together.passed) << together.report;
+  EXPECT_NE(together.report.find("by 50 % + 0.02 mm per run and by 10 % over all runs"), std::string::npos)
+      << together.report;
+  EXPECT_NE(together.report.find("better / same / worse): 0 / 0 / 4; RMSE ratio now / before, geometric mean: "
+                                 "1.200, allowed 1.100: WORSE"),
+            std::string::npos)
+      << together.report;
+  EXPECT_NE(together.report.find("FAILED: the runs together are worse than the baseline allows"), std::string::npos);
+  // Chaos, not a change for the worse: one run 40 % worse and another 30 % better (ratio 0.98).
+  std::vector<RunResult> scattered = before;
+  scattered[0].rmse_mm = 1.4;
+  scattered[3].rmse_mm = 5.6;
+  EXPECT_TRUE(CheckBaseline(scattered, baseline).passed) << CheckBaseline(scattered, baseline).report;
+  // Just inside (every run 9 % worse) and the ratio is the geometric one: 1.21 × 1 × 1 × 1 is
+  // 21 % on the arithmetic mean of ratios' scale but 4.9 % as a geometric mean.
+  std::vector<RunResult> inside = before;
+  for (RunResult& r : inside) r.rmse_mm *= 1.09;
+  EXPECT_TRUE(CheckBaseline(inside, baseline).passed);
+  std::vector<RunResult> one_run = before;
+  one_run[2].rmse_mm *= 1.21;
+  EXPECT_TRUE(CheckBaseline(one_run, baseline).passed);
+  // Baselines from before the pooled check have no such field: they check run by run only,
+  // and still report the pooled ratio.
+  Json older = baseline;
+  older["tolerance"].erase("pooled_rmse_relative");
+  const BaselineCheck unpooled = CheckBaseline(worse, older);
+  EXPECT_TRUE(unpooled.passed) << unpooled.report;
+  EXPECT_NE(unpooled.report.find("geometric mean: 1.200; signed-rank p = "), std::string::npos) << unpooled.report;
+  older["tolerance"]["pooled_rmse_relative"] = -0.1;
+  EXPECT_THROW(CheckBaseline(before, older), Error);
+}
+
 TEST(Results, CsvNamesTheCodeOfEveryRun) {
   const auto folder = UniqueTempFolder("results_csv");
   RunResult recorded = Result("a", 1.5, 60);

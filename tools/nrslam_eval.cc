@@ -45,7 +45,8 @@ nrslam::Programs SiblingPrograms() {
 // Exit codes: 0 all well, 1 bad usage or input, 2 some run failed, 3 baseline check failed.
 // `baseline`: the --check-baseline file as read before the runs.
 int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
-           const std::optional<nrslam::Json>& baseline, const std::string& write_baseline, double tolerance) {
+           const std::optional<nrslam::Json>& baseline, const std::string& write_baseline,
+           const nrslam::BaselineTolerance& tolerance) {
   const std::vector<nrslam::RunResult> results = nrslam::CollectResults(plan);
   const std::vector<nrslam::RigidComparison> comparisons = nrslam::CompareWithRigid(plan, results);
   nrslam::WriteResults(results, out);
@@ -65,9 +66,7 @@ int Finish(const nrslam::EvaluationPlan& plan, const std::filesystem::path& out,
   int code = 0;
   for (const auto& result : results) code = result.status == "failed" ? 2 : code;
   if (!write_baseline.empty()) {
-    nrslam::BaselineTolerance given;
-    given.rmse_relative = tolerance;
-    nrslam::WriteTextFile(write_baseline, nrslam::MakeBaseline(results, given).dump(2) + '\n');
+    nrslam::WriteTextFile(write_baseline, nrslam::MakeBaseline(results, tolerance).dump(2) + '\n');
     std::cout << "baseline written: " << write_baseline << '\n';
   }
   if (baseline) {
@@ -121,7 +120,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> assignments, sweeps, only;
   std::string seeds;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
-  double tolerance = 0.10;
+  nrslam::BaselineTolerance tolerance;  // of a written baseline; the other fields keep their defaults
   double run_timeout = 0;
   bool dry_run = false;
   app.add_option("manifest", manifest_path, "manifest JSON (see data_manifests/)");
@@ -152,7 +151,14 @@ int main(int argc, char** argv) {
                                             "instead of running them");
   app.add_option("--check-baseline", check_baseline, "fail (exit 3) when a run is worse than this baseline file");
   app.add_option("--write-baseline", write_baseline, "write the results as a baseline file");
-  app.add_option("--tolerance", tolerance, "relative RMSE growth a written baseline allows")->capture_default_str();
+  app.add_option("--tolerance", tolerance.rmse_relative, "relative RMSE growth per run a written baseline allows")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--pooled-tolerance", tolerance.pooled_rmse_relative,
+                 "relative growth of the geometric mean RMSE ratio over all runs a written baseline allows; 0: no "
+                 "such check (for chaotic runs: a loose --tolerance per run and a tight one over many runs)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   CLI::App* merge = app.add_subcommand("merge", "aggregate result folders (their run folders) into --out");
   merge->fallthrough();  // --out, --set, --sweep, --check-baseline given after "merge" too
   std::vector<std::string> merge_folders;

@@ -558,7 +558,8 @@ Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance
   return {{"tolerance",
            {{"rmse_relative", tolerance.rmse_relative},
             {"rmse_absolute_mm", tolerance.rmse_absolute_mm},
-            {"frames_tracked", tolerance.frames_tracked}}},
+            {"frames_tracked", tolerance.frames_tracked},
+            {"pooled_rmse_relative", tolerance.pooled_rmse_relative}}},
           {"runs", runs}};
 }
 
@@ -572,6 +573,9 @@ BaselineTolerance ToleranceOf(const Json& baseline) {
     tolerance.rmse_relative = given.at("rmse_relative");
     tolerance.rmse_absolute_mm = given.at("rmse_absolute_mm");
     tolerance.frames_tracked = given.at("frames_tracked");
+    // Baselines written before the pooled check have none: they check run by run only.
+    tolerance.pooled_rmse_relative = given.value("pooled_rmse_relative", 0.0);
+    if (!(tolerance.pooled_rmse_relative >= 0)) throw Error("baseline: \"pooled_rmse_relative\" must be 0 or more");
     if (!baseline.at("runs").is_object()) throw Error("baseline: \"runs\" must map run names to their figures");
     for (const auto& [key, run] : baseline.at("runs").items()) {
       if (!run.is_object() || !run.value("rmse_mm", Json()).is_number() ||
@@ -605,6 +609,7 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   std::vector<std::string> baseline_revisions, baseline_codes, run_codes;
   for (const RunResult& r : results) run_codes.push_back(r.code);
   BaselineCheck check;
+  RmseChangeCounts pooled;  // over the runs with a figure on both sides
   TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
   for (const auto& [key, expected] : runs.items()) {
     baseline_revisions.push_back(expected.value("revision", ""));
@@ -620,6 +625,7 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
       row.insert(row.end(), {"-", FormatFixed(allowed, 3), std::to_string(tracked_before), "-"});
     } else {
       const RunResult& now = *found->second;
+      pooled.Add(rmse_before, now.rmse_mm);
       if (now.frames_tracked < tracked_before - tolerance.frames_tracked) {
         verdict = "WORSE: fewer frames tracked";
       } else if (now.rmse_mm > allowed) {
@@ -636,12 +642,32 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   }
   std::ostringstream report;
   report << "Baseline check (RMSE may grow by " << FormatFixed(100 * tolerance.rmse_relative, 0) << " % + "
-         << tolerance.rmse_absolute_mm << " mm; frames tracked may drop by " << tolerance.frames_tracked << "):\n"
+         << tolerance.rmse_absolute_mm << " mm per run";
+  if (tolerance.pooled_rmse_relative > 0) {
+    report << " and by " << FormatFixed(100 * tolerance.pooled_rmse_relative, 0) << " % over all runs (geometric mean)";
+  }
+  report << "; frames tracked may drop by " << tolerance.frames_tracked << "):\n"
          << "code of the baseline: " << DescribeRevisions(baseline_revisions) << "; of these runs: " << DescribeRevisions(results);
   const std::string same_code = CompareCode(baseline_codes, run_codes);
   report << (same_code.empty() ? "" : " (" + same_code + ")") << '\n';
   table.Print(report);
-  report << (check.passed ? "PASSED" : "FAILED: at least one run is worse than the baseline allows") << '\n';
+  const double ratio = pooled.GeometricMeanRatio();
+  const bool pooled_passed =
+      tolerance.pooled_rmse_relative == 0 || ratio <= 1.0 + tolerance.pooled_rmse_relative;
+  report << "All runs together (better / same / worse): " << pooled.ToString()
+         << "; RMSE ratio now / before, geometric mean: " << FormatFixed(ratio, 3);
+  if (tolerance.pooled_rmse_relative > 0) {
+    report << ", allowed " << FormatFixed(1.0 + tolerance.pooled_rmse_relative, 3) << (pooled_passed ? "" : ": WORSE");
+  }
+  report << "; signed-rank p = " << FormatFixed(pooled.SignedRankP(), 3) << '\n';
+  if (!check.passed) {
+    report << "FAILED: at least one run is worse than the baseline allows\n";
+  } else if (!pooled_passed) {
+    report << "FAILED: the runs together are worse than the baseline allows\n";
+  } else {
+    report << "PASSED\n";
+  }
+  check.passed &= pooled_passed;
   check.report = report.str();
   return check;
 }
