@@ -149,7 +149,8 @@ int main(int argc, char** argv) {
                "list the sequences it would render and the runs it would run (and which are done already), run nothing");
   app.add_option("--emit-jobs", emit_jobs, "write one shell command per run to FILE (for GNU parallel, Slurm) "
                                             "instead of running them");
-  app.add_option("--check-baseline", check_baseline, "fail (exit 3) when a run, or all runs together, are worse than this baseline file allows");
+  app.add_option("--check-baseline", check_baseline,
+                 "fail (exit 3) when a run, or all runs together, are worse than this baseline file allows");
   app.add_option("--write-baseline", write_baseline, "write the results as a baseline file");
   app.add_option("--tolerance", tolerance.rmse_relative, "relative RMSE growth per run a written baseline allows")
       ->capture_default_str()
