@@ -434,7 +434,7 @@ TEST(Baseline, APooledToleranceCatchesRunsWorseTogetherThatEachPassAlone) {
   EXPECT_NE(together.report.find("by 50 % + 0.02 mm per run and by 10 % over all runs"), std::string::npos)
       << together.report;
   EXPECT_NE(together.report.find("better / same / worse): 0 / 0 / 4; RMSE ratio now / before, geometric mean: "
-                                 "1.200, allowed 1.100: WORSE"),
+                                 "1.200 (95 % CI 1.200 to 1.200), allowed 1.100: WORSE"),
             std::string::npos)
       << together.report;
   EXPECT_NE(together.report.find("FAILED: the runs together are worse than the baseline allows"), std::string::npos);
@@ -456,7 +456,7 @@ TEST(Baseline, APooledToleranceCatchesRunsWorseTogetherThatEachPassAlone) {
   older["tolerance"].erase("pooled_rmse_relative");
   const BaselineCheck unpooled = CheckBaseline(worse, older);
   EXPECT_TRUE(unpooled.passed) << unpooled.report;
-  EXPECT_NE(unpooled.report.find("geometric mean: 1.200; signed-rank p = "), std::string::npos) << unpooled.report;
+  EXPECT_NE(unpooled.report.find("geometric mean: 1.200 (95 % CI 1.200 to 1.200); signed-rank p = "), std::string::npos) << unpooled.report;
   older["tolerance"]["pooled_rmse_relative"] = -0.1;
   EXPECT_THROW(CheckBaseline(before, older), Error);
 }
@@ -904,6 +904,29 @@ TEST(Results, SignedRankTestKnownAnswers) {
   EXPECT_DOUBLE_EQ(RmseChangeCounts().GeometricMeanRatio(), 1.0);
 }
 
+// Known answers of the geometric mean ratio's confidence interval: Student's t over the log ratios.
+TEST(Results, GeometricMeanRatioIntervalKnownAnswers) {
+  // Log ratios 0, 0.2, 0.4: mean 0.2, standard error 0.2 / √3, t* = 4.302653 at 2 degrees of
+  // freedom, so the interval is exp(0.2 ± 0.496827).
+  RmseChangeCounts three;
+  for (double log_ratio : {0.0, 0.2, 0.4}) three.Add(2.0, 2.0 * std::exp(log_ratio));
+  const auto interval = three.GeometricMeanRatioInterval();
+  ASSERT_TRUE(interval.has_value());
+  EXPECT_NEAR(interval->low, 0.743172167, 1e-8);
+  EXPECT_NEAR(interval->high, 2.007374285, 1e-8);
+  EXPECT_EQ(three.GeometricMeanRatioText(), "1.221 (95 % CI 0.743 to 2.007)");
+  EXPECT_EQ(three.GeometricMeanRatioText(true), "0.819 (95 % CI 0.498 to 1.346)");
+  // A wider confidence gives a wider interval around the same ratio.
+  const auto wider = three.GeometricMeanRatioInterval(0.99);
+  EXPECT_LT(wider->low, interval->low);
+  EXPECT_GT(wider->high, interval->high);
+  // One pair has no spread to measure: no interval, the ratio alone.
+  RmseChangeCounts one;
+  one.Add(1.0, 1.5);
+  EXPECT_FALSE(one.GeometricMeanRatioInterval().has_value());
+  EXPECT_EQ(one.GeometricMeanRatioText(), "1.500");
+}
+
 // Known answers of the two-sided exact sign test: 2 · P(Binomial(n, 1/2) ≥ the larger count).
 TEST(Results, SignTestOverTheRunsThatMoved) {
   const auto p = [](int better, int same, int worse) {
@@ -965,7 +988,7 @@ TEST(Results, DiffPairsTwoEvaluationsRunForRun) {
             std::string::npos);
   EXPECT_NEAR(diff.b_against_a.GeometricMeanRatio(), std::cbrt(1.0003 * (2.0 / 3) * 1.25), 1e-12);
   for (const char* expected : {"1 / 1 / 1", "p = 1.000", "absent", "FAILED", "-1.000", "0.500",
-                               "geometric mean over the runs: 0.941"}) {
+                               "geometric mean over the runs: 0.941 (95 % CI 0.426 to 2.077)"}) {
     EXPECT_NE(table.str().find(expected), std::string::npos) << expected << "\n" << table.str();
   }
   // A run without a trajectory error leaves the mean ATE out rather than averaging a gap.
@@ -1147,10 +1170,12 @@ TEST(RigidComparison, PairsRunsThatDifferOnlyInRigidity) {
   EXPECT_EQ(tally.same_points.ToString(), "0 / 0 / 0");
   table.str("");
   PrintRigidComparison(three, table);
-  // Own: ratios rigid / deformable 1/6, 2, 2, geometric mean 1.5^(-1/3) = 0.874; |log ratio|
-  // ranks 1.5, 1.5, 3 with the worse run's 3, as likely as not under the null: p = 1.
-  EXPECT_NE(table.str().find("own RMSE 2 / 0 / 1 (sign test p = 1.000; ratio, geometric mean 0.874, signed-rank p = "
-                             "1.000); common frames 2 / 0 / 1 (sign test p = 1.000; ratio, geometric mean 1.260"),
+  // Own: ratios rigid / deformable 1/6, 2, 2, geometric mean 1.5^(-1/3) = 0.874, its interval
+  // the reciprocal of the deformable / rigid one (Student's t at 2 degrees of freedom); |log
+  // ratio| ranks 1.5, 1.5, 3 with the worse run's 3, as likely as not under the null: p = 1.
+  EXPECT_NE(table.str().find("own RMSE 2 / 0 / 1 (sign test p = 1.000; ratio, geometric mean 0.874 (95 % CI 0.025 "
+                             "to 30.838), signed-rank p = 1.000); common frames 2 / 0 / 1 (sign test p = 1.000; "
+                             "ratio, geometric mean 1.260"),
             std::string::npos)
       << table.str();
   std::filesystem::remove_all(folder);

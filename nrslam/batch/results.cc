@@ -12,6 +12,7 @@
 #include "nrslam/util/csv.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
+#include "nrslam/util/student_t.h"
 #include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
@@ -131,6 +132,27 @@ double RmseChangeCounts::GeometricMeanRatio() const {
   double sum = 0;
   for (double r : log_ratios) sum += r;
   return std::exp(sum / log_ratios.size());
+}
+
+std::optional<RmseChangeCounts::RatioInterval> RmseChangeCounts::GeometricMeanRatioInterval(double confidence) const {
+  const size_t n = log_ratios.size();
+  if (n < 2) return std::nullopt;
+  const double mean = Mean(log_ratios);
+  double squares = 0;
+  for (double r : log_ratios) squares += (r - mean) * (r - mean);
+  const double standard_error = std::sqrt(squares / (n - 1) / n);
+  const double half_width = StudentTCriticalValue(confidence, static_cast<int>(n) - 1) * standard_error;
+  return RatioInterval{std::exp(mean - half_width), std::exp(mean + half_width)};
+}
+
+std::string RmseChangeCounts::GeometricMeanRatioText(bool reciprocal) const {
+  const auto oriented = [reciprocal](double ratio) { return FormatFixed(reciprocal ? 1 / ratio : ratio, 3); };
+  std::string text = oriented(GeometricMeanRatio());
+  if (const auto interval = GeometricMeanRatioInterval()) {
+    const double low = reciprocal ? interval->high : interval->low, high = reciprocal ? interval->low : interval->high;
+    text += " (95 % CI " + oriented(low) + " to " + oriented(high) + ")";
+  }
+  return text;
 }
 
 double RmseChangeCounts::SignedRankP() const {
@@ -469,17 +491,20 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
 
 std::vector<std::string> SweepSummaryHeader() {
   return {"option", "value", "mean RMSE mm", "median mm", "mean 1 scale mm", "mean ATE mm", "runs", "not to end",
-          "vs default: better / same / worse", "sign test p", "RMSE ratio to default", "signed-rank p"};
+          "vs default: better / same / worse", "sign test p", "RMSE ratio to default", "its 95 % CI",
+          "signed-rank p"};
 }
 
 std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const bool any = v.runs > 0;
   const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
   const auto if_paired = [&v](double figure) { return v.paired ? FormatFixed(figure, 3) : std::string("-"); };
+  const auto ci = v.paired ? v.against_default.GeometricMeanRatioInterval() : std::nullopt;
+  const std::string interval = ci ? FormatFixed(ci->low, 3) + " to " + FormatFixed(ci->high, 3) : "-";
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
           any ? MillimetresCell(v.mean_map_scale_mm) : "-", any ? MillimetresCell(v.mean_ate_mm) : "-", std::to_string(v.runs),
           std::to_string(v.short_runs), paired, if_paired(v.against_default.SignTestP()),
-          if_paired(v.against_default.GeometricMeanRatio()), if_paired(v.against_default.SignedRankP())};
+          if_paired(v.against_default.GeometricMeanRatio()), interval, if_paired(v.against_default.SignedRankP())};
 }
 
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results) {
@@ -655,7 +680,7 @@ BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& b
   const bool pooled_passed =
       tolerance.pooled_rmse_relative == 0 || ratio <= 1.0 + tolerance.pooled_rmse_relative;
   report << "All runs together (better / same / worse): " << pooled.ToString()
-         << "; RMSE ratio now / before, geometric mean: " << FormatFixed(ratio, 3);
+         << "; RMSE ratio now / before, geometric mean: " << pooled.GeometricMeanRatioText();
   if (tolerance.pooled_rmse_relative > 0) {
     report << ", allowed " << FormatFixed(1.0 + tolerance.pooled_rmse_relative, 3) << (pooled_passed ? "" : ": WORSE");
   }

@@ -76,6 +76,16 @@ struct RmseChangeCounts {
   // exp(mean log ratio): the factor by which the RMSE typically changed (0.9: 10 % lower),
   // so that a 0.3 mm and a 15 mm sequence weigh alike. 1 with no pair.
   double GeometricMeanRatio() const;
+  // The `confidence` interval of that factor, from Student's t over the log ratios: how far
+  // the typical change could be from the measured one, were the same runs drawn again from
+  // the scenes and seeds they stand for. Needs 2 pairs or more.
+  struct RatioInterval {
+    double low = 1, high = 1;
+  };
+  std::optional<RatioInterval> GeometricMeanRatioInterval(double confidence = 0.95) const;
+  // "1.043 (95 % CI 0.981–1.109)", or without the interval when there is none; `reciprocal`
+  // prints the ratio the other way up (reference / RMSE).
+  std::string GeometricMeanRatioText(bool reciprocal = false) const;
   // Two-sided Wilcoxon signed-rank test of the log ratios of the runs that moved: like the
   // sign test, but a run that changed much counts more than one that changed a little.
   // Exact (the permutation distribution of the tied ranks) up to 200 runs, the normal

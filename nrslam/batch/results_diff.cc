@@ -158,7 +158,7 @@ void PrintDiff(const ResultsDiff& diff, const std::string& name_a, const std::st
     summary.Print(out);
     out << "B against A, run for run (better / same / worse): " << diff.b_against_a.ToString()
         << "; two-sided sign test over the runs that moved: p = " << FormatFixed(diff.b_against_a.SignTestP(), 3)
-        << "\nRMSE ratio B / A, geometric mean over the runs: " << FormatFixed(diff.b_against_a.GeometricMeanRatio(), 3)
+        << "\nRMSE ratio B / A, geometric mean over the runs: " << diff.b_against_a.GeometricMeanRatioText()
         << "; two-sided Wilcoxon signed-rank test of log(B / A) over the runs that moved: p = "
         << FormatFixed(diff.b_against_a.SignedRankP(), 3) << '\n';
   }

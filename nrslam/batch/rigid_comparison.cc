@@ -100,7 +100,7 @@ std::string RigidComparisonTallyText(const RigidComparisonTally& tally) {
   const auto count = [](const RmseChangeCounts& counts) {
     // The ratio the other way up, as the table's: rigid / deformable, above 1 where deformable wins.
     return counts.ToString() + " (sign test p = " + FormatFixed(counts.SignTestP(), 3) + "; ratio, geometric mean " +
-           FormatFixed(1 / counts.GeometricMeanRatio(), 3) + ", signed-rank p = " + FormatFixed(counts.SignedRankP(), 3) + ")";
+           counts.GeometricMeanRatioText(true) + ", signed-rank p = " + FormatFixed(counts.SignedRankP(), 3) + ")";
   };
   return "Deformable better / same / worse than rigid: own RMSE " + count(tally.own) + "; common frames " +
          count(tally.common) + "; same points " + count(tally.same_points) + ".";
