@@ -456,7 +456,8 @@ TEST(Baseline, APooledToleranceCatchesRunsWorseTogetherThatEachPassAlone) {
   older["tolerance"].erase("pooled_rmse_relative");
   const BaselineCheck unpooled = CheckBaseline(worse, older);
   EXPECT_TRUE(unpooled.passed) << unpooled.report;
-  EXPECT_NE(unpooled.report.find("geometric mean: 1.200 (95 % CI 1.200 to 1.200); signed-rank p = "), std::string::npos) << unpooled.report;
+  EXPECT_NE(unpooled.report.find("geometric mean: 1.200 (95 % CI 1.200 to 1.200); signed-rank p = "), std::string::npos)
+      << unpooled.report;
   older["tolerance"]["pooled_rmse_relative"] = -0.1;
   EXPECT_THROW(CheckBaseline(before, older), Error);
 }

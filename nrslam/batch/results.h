@@ -83,7 +83,7 @@ struct RmseChangeCounts {
     double low = 1, high = 1;
   };
   std::optional<RatioInterval> GeometricMeanRatioInterval(double confidence = 0.95) const;
-  // "1.043 (95 % CI 0.981–1.109)", or without the interval when there is none; `reciprocal`
+  // "1.043 (95 % CI 0.981 to 1.109)", or without the interval when there is none; `reciprocal`
   // prints the ratio the other way up (reference / RMSE).
   std::string GeometricMeanRatioText(bool reciprocal = false) const;
   // Two-sided Wilcoxon signed-rank test of the log ratios of the runs that moved: like the
