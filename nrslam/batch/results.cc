@@ -128,10 +128,7 @@ void RmseChangeCounts::Add(double reference_mm, double rmse_mm) {
 }
 
 double RmseChangeCounts::GeometricMeanRatio() const {
-  if (log_ratios.empty()) return 1.0;
-  double sum = 0;
-  for (double r : log_ratios) sum += r;
-  return std::exp(sum / log_ratios.size());
+  return log_ratios.empty() ? 1.0 : std::exp(Mean(log_ratios));
 }
 
 std::optional<RmseChangeCounts::RatioInterval> RmseChangeCounts::GeometricMeanRatioInterval(double confidence) const {
