@@ -142,14 +142,18 @@ std::optional<RmseChangeCounts::RatioInterval> RmseChangeCounts::GeometricMeanRa
   return RatioInterval{std::exp(mean - half_width), std::exp(mean + half_width)};
 }
 
-std::string RmseChangeCounts::GeometricMeanRatioText(bool reciprocal) const {
+std::string RmseChangeCounts::GeometricMeanRatioIntervalText(bool reciprocal) const {
+  const auto interval = GeometricMeanRatioInterval();
+  if (!interval) return "";
   const auto oriented = [reciprocal](double ratio) { return FormatFixed(reciprocal ? 1 / ratio : ratio, 3); };
-  std::string text = oriented(GeometricMeanRatio());
-  if (const auto interval = GeometricMeanRatioInterval()) {
-    const double low = reciprocal ? interval->high : interval->low, high = reciprocal ? interval->low : interval->high;
-    text += " (95 % CI " + oriented(low) + " to " + oriented(high) + ")";
-  }
-  return text;
+  return reciprocal ? oriented(interval->high) + " to " + oriented(interval->low)
+                    : oriented(interval->low) + " to " + oriented(interval->high);
+}
+
+std::string RmseChangeCounts::GeometricMeanRatioText(bool reciprocal) const {
+  const double ratio = GeometricMeanRatio();
+  const std::string interval = GeometricMeanRatioIntervalText(reciprocal);
+  return FormatFixed(reciprocal ? 1 / ratio : ratio, 3) + (interval.empty() ? "" : " (95 % CI " + interval + ")");
 }
 
 double RmseChangeCounts::SignedRankP() const {
@@ -496,12 +500,12 @@ std::vector<std::string> SweepSummaryCells(const SweepValueSummary& v) {
   const bool any = v.runs > 0;
   const std::string paired = v.is_default ? "(default)" : v.paired ? v.against_default.ToString() : "-";
   const auto if_paired = [&v](double figure) { return v.paired ? FormatFixed(figure, 3) : std::string("-"); };
-  const auto ci = v.paired ? v.against_default.GeometricMeanRatioInterval() : std::nullopt;
-  const std::string interval = ci ? FormatFixed(ci->low, 3) + " to " + FormatFixed(ci->high, 3) : "-";
+  const std::string interval = v.paired ? v.against_default.GeometricMeanRatioIntervalText() : "";
   return {v.option, v.value, any ? FormatFixed(v.mean_rmse_mm, 3) : "-", any ? FormatFixed(v.median_rmse_mm, 3) : "-",
           any ? MillimetresCell(v.mean_map_scale_mm) : "-", any ? MillimetresCell(v.mean_ate_mm) : "-", std::to_string(v.runs),
           std::to_string(v.short_runs), paired, if_paired(v.against_default.SignTestP()),
-          if_paired(v.against_default.GeometricMeanRatio()), interval, if_paired(v.against_default.SignedRankP())};
+          if_paired(v.against_default.GeometricMeanRatio()), interval.empty() ? "-" : interval,
+          if_paired(v.against_default.SignedRankP())};
 }
 
 std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& results) {

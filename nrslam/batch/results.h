@@ -83,8 +83,10 @@ struct RmseChangeCounts {
     double low = 1, high = 1;
   };
   std::optional<RatioInterval> GeometricMeanRatioInterval(double confidence = 0.95) const;
-  // "1.043 (95 % CI 0.981 to 1.109)", or without the interval when there is none; `reciprocal`
-  // prints the ratio the other way up (reference / RMSE).
+  // The 95 % interval as tables print it, "0.981 to 1.109", or "" when there is none;
+  // `reciprocal` turns it the other way up (reference / RMSE).
+  std::string GeometricMeanRatioIntervalText(bool reciprocal = false) const;
+  // The ratio with that interval, "1.043 (95 % CI 0.981 to 1.109)", or the ratio alone.
   std::string GeometricMeanRatioText(bool reciprocal = false) const;
   // Two-sided Wilcoxon signed-rank test of the log ratios of the runs that moved: like the
   // sign test, but a run that changed much counts more than one that changed a little.
