@@ -1,4 +1,4 @@
-// io: reads a sequence folder (format in the README), validating all of it up front.
+// io: reads a sequence folder (format in docs/data.md), validating all of it up front.
 //
 // The constructor checks every file the sequence promises (existence, PNG header, size,
 // bit depth, ground-truth line count) before the first frame is read, and throws one Error

@@ -33,7 +33,7 @@ struct RunOptions {
   // on, and takes over on the frame it starts, so no frame is left untracked. 0 = never.
   // Not in the paper. 10 leaves every measured 120-frame run as it was (the farthest, a colon
   // rendering, moves 9.7×) and restarts a deforming colon's map every ~200 frames, which keeps a
-  // 1000-frame run's camera from drifting away with the scale (README, "A collapsing map is replaced").
+  // 1000-frame run's camera from drifting away with the scale (docs/tracking.md, "A collapsing map is replaced").
   double restart_on_depth_change = 10;
   void Check() const;
 };

@@ -27,7 +27,7 @@ struct TrackingOptions {
   // SSIM (after the KLT's light correction) above this, and their median gain α inside the
   // KLT's bounds. Then the view is partly hidden (an instrument, a mask) and the tracks left are
   // right; on noise the chance matches scored a median SSIM of 0.79–0.82 with α at a bound,
-  // on a view 60 % hidden 0.92–0.99 (README, "Sequence format"). 1: every such frame skipped.
+  // on a view 60 % hidden 0.92–0.99 (docs/data.md, "Sequence format"). 1: every such frame skipped.
   double dropout_min_match_ssim = 0.88;
   // A tracked frame whose map tracks moved more than this many times as far as over the recent
   // frames (median px, against the median of the last 10 tracked frames' medians, taken as at
@@ -82,7 +82,7 @@ struct TrackingOptions {
   // where its points were left. Tracking a map from depth, it keeps sim-3 with an instrument
   // over 60 % of the view for 10 frames tracked to the end (93 of 120 frames without). Points
   // lost otherwise are not searched so: their offset more often says the map position is stale
-  // (README, "Tracking and the runner"). 0: the gate alone.
+  // (docs/tracking.md, "Tracking and the runner"). 0: the gate alone.
   int reassociation_consensus_k = 4;
   // A map point the KLT loses at least hidden_min_edge_fraction of the image's shorter side
   // inside it is taken as hidden (for the consensus above) when at least half of the k map
@@ -90,7 +90,7 @@ struct TrackingOptions {
   // sliding over the view, which no single frame shows as a sudden occlusion. Nearer the edge,
   // points are lost as the view moves on: in the unoccluded sim-3, 397 of its 401 losses over 60
   // frames were within 40 px of it (640×480), and at 42 px a colon rendering still had such
-  // clusters (README, "Tracking and the runner").
+  // clusters (docs/tracking.md, "Tracking and the runner").
   int hidden_recent_frames = 5;            // frames; 0: only sudden occlusions and masks hide points
   double hidden_min_edge_fraction = 0.17;  // of the shorter side (82 px at 640×480)
   int lost_max_age_frames = 90;   // a point lost longer ago is neither moved nor looked for (bounds work)
