@@ -1,7 +1,8 @@
 // The documentation's links resolve: every relative link in the README, the docs pages and the
 // library folders' READMEs names a file that exists and, with a #fragment, a heading of that
 // file. The pages name each other's sections often, and a page split or a renamed heading
-// would otherwise leave links that lead nowhere.
+// would otherwise leave links that lead nowhere. The pages that the code, the tools' help, the
+// manifests and CI name must exist too.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -114,6 +115,28 @@ std::vector<fs::path> DocumentationFiles() {
   return files;
 }
 
+// Every "docs/<page>.md" that the code, the tools' help, the manifests or CI name, with where.
+std::vector<std::string> NamedDocsPages() {
+  std::vector<std::string> named;
+  static const std::regex page(R"(docs/[A-Za-z0-9_-]+\.md)");
+  std::vector<fs::path> files = {kSourceDir / ".ci" / "run"};
+  for (const fs::path& folder : {kSourceDir / "nrslam", kSourceDir / "tools", kSourceDir / "data_manifests"}) {
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(folder)) {
+      const std::string extension = entry.path().extension().string();
+      if (extension == ".h" || extension == ".cc" || extension == ".json" || extension == ".md") {
+        files.push_back(entry.path());
+      }
+    }
+  }
+  for (const fs::path& file : files) {
+    const std::string text = ReadText(file);
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), page); it != std::sregex_iterator(); ++it) {
+      named.push_back(it->str() + " (named in " + file.string() + ")");
+    }
+  }
+  return named;
+}
+
 TEST(DocsLinks, HeadingAnchorsAreGitHubs) {
   EXPECT_EQ(HeadingAnchor("Tracking and the runner: `nrslam_run`"), "tracking-and-the-runner-nrslam_run");
   EXPECT_EQ(HeadingAnchor("Quick start (Debian 12)"), "quick-start-debian-12");
@@ -144,6 +167,15 @@ TEST(DocsLinks, EveryRelativeLinkOfTheDocumentationResolves) {
   ASSERT_GE(files.size(), 7u);  // the README, five docs pages, the library's folder READMEs
   for (const fs::path& file : files) {
     for (const std::string& problem : BrokenLinks(file)) ADD_FAILURE() << problem;
+  }
+}
+
+TEST(DocsLinks, EveryDocsPageTheCodeNamesExists) {
+  const std::vector<std::string> named = NamedDocsPages();
+  ASSERT_GE(named.size(), 6u);  // the tools' help names a page each
+  for (const std::string& mention : named) {
+    const std::string page = mention.substr(0, mention.find(' '));
+    EXPECT_TRUE(fs::exists(kSourceDir / page)) << mention;
   }
 }
 

@@ -14,6 +14,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"Import a dataset into the nrslam sequence format"};
   app.set_version_flag("--version", nrslam::VersionString());
+  app.footer("Documentation: docs/eval.md in the source tree, \"Public datasets on your disk\" and "
+             "\"Raw stereo recordings\".");
   nrslam::ImportOptions options;
   std::string out;
   app.add_option("--format", options.format, "endomapper-sim, hamlyn, c3vd, images or stereo")->required();
