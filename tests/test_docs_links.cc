@@ -115,9 +115,14 @@ std::vector<fs::path> DocumentationFiles() {
   return files;
 }
 
-// Every "docs/<page>.md" that the code, the tools' help, the manifests or CI name, with where.
-std::vector<std::string> NamedDocsPages() {
-  std::vector<std::string> named;
+struct PageMention {
+  std::string page;  // docs/<page>.md
+  fs::path file;     // where it is named
+};
+
+// Every "docs/<page>.md" that the code, the tools' help, the manifests or CI name.
+std::vector<PageMention> NamedDocsPages() {
+  std::vector<PageMention> named;
   static const std::regex page(R"(docs/[A-Za-z0-9_-]+\.md)");
   std::vector<fs::path> files = {kSourceDir / ".ci" / "run"};
   for (const fs::path& folder : {kSourceDir / "nrslam", kSourceDir / "tools", kSourceDir / "data_manifests"}) {
@@ -131,7 +136,7 @@ std::vector<std::string> NamedDocsPages() {
   for (const fs::path& file : files) {
     const std::string text = ReadText(file);
     for (auto it = std::sregex_iterator(text.begin(), text.end(), page); it != std::sregex_iterator(); ++it) {
-      named.push_back(it->str() + " (named in " + file.string() + ")");
+      named.push_back({it->str(), file});
     }
   }
   return named;
@@ -171,11 +176,10 @@ TEST(DocsLinks, EveryRelativeLinkOfTheDocumentationResolves) {
 }
 
 TEST(DocsLinks, EveryDocsPageTheCodeNamesExists) {
-  const std::vector<std::string> named = NamedDocsPages();
+  const std::vector<PageMention> named = NamedDocsPages();
   ASSERT_GE(named.size(), 6u);  // the tools' help names a page each
-  for (const std::string& mention : named) {
-    const std::string page = mention.substr(0, mention.find(' '));
-    EXPECT_TRUE(fs::exists(kSourceDir / page)) << mention;
+  for (const PageMention& mention : named) {
+    EXPECT_TRUE(fs::exists(kSourceDir / mention.page)) << mention.page << ", named in " << mention.file;
   }
 }
 
