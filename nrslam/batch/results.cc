@@ -88,6 +88,9 @@ std::string PairKey(const RunResult& run, const std::string& option, const std::
   return key;
 }
 
+// A ratio as the tables print it; `reciprocal` turns it the other way up.
+std::string RatioCell(double ratio, bool reciprocal) { return FormatFixed(reciprocal ? 1 / ratio : ratio, 3); }
+
 }  // namespace
 
 std::string DescribeRevisions(const std::vector<std::string>& revisions) {
@@ -145,15 +148,14 @@ std::optional<RmseChangeCounts::RatioInterval> RmseChangeCounts::GeometricMeanRa
 std::string RmseChangeCounts::GeometricMeanRatioIntervalText(bool reciprocal) const {
   const auto interval = GeometricMeanRatioInterval();
   if (!interval) return "";
-  const auto oriented = [reciprocal](double ratio) { return FormatFixed(reciprocal ? 1 / ratio : ratio, 3); };
-  return reciprocal ? oriented(interval->high) + " to " + oriented(interval->low)
-                    : oriented(interval->low) + " to " + oriented(interval->high);
+  // Turned the other way up, the interval's upper end becomes the lower.
+  const double first = reciprocal ? interval->high : interval->low, last = reciprocal ? interval->low : interval->high;
+  return RatioCell(first, reciprocal) + " to " + RatioCell(last, reciprocal);
 }
 
 std::string RmseChangeCounts::GeometricMeanRatioText(bool reciprocal) const {
-  const double ratio = GeometricMeanRatio();
   const std::string interval = GeometricMeanRatioIntervalText(reciprocal);
-  return FormatFixed(reciprocal ? 1 / ratio : ratio, 3) + (interval.empty() ? "" : " (95 % CI " + interval + ")");
+  return RatioCell(GeometricMeanRatio(), reciprocal) + (interval.empty() ? "" : " (95 % CI " + interval + ")");
 }
 
 double RmseChangeCounts::SignedRankP() const {
