@@ -33,6 +33,7 @@
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
+#include "shell_command.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -1553,14 +1554,6 @@ std::filesystem::path StandInRunner(const std::filesystem::path& folder, const s
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({"sequences": [)" + sequences + "]}"));
   *plan = PlanEvaluation(manifest, {}, {}, folder / "out", folder / "cache");
   return runner;
-}
-
-// Runs a shell command with its standard output and error caught in `log`: its exit status and
-// what it printed.
-std::pair<int, std::string> RunCaught(const std::string& command, const std::filesystem::path& log) {
-  const int status = std::system((command + " > " + log.string() + " 2>&1").c_str());
-  std::ifstream stream(log);
-  return {status, std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>())};
 }
 
 // A baseline that could not serve a check is refused when it is read, saying why; nrslam_eval

@@ -1,0 +1,93 @@
+// Tests: the installation (cmake/NrslamInstall.cmake). nrslam is installed into a temporary
+// prefix and used from there alone, as by someone who builds on it: another CMake project
+// (tests/install_consumer) finds the package, compiles every installed header, links the library
+// and tracks a sequence with it, and the installed nrslam_eval runs a manifest from the
+// installed share folder.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "nrslam/util/source_revision.h"
+#include "shell_command.h"
+#include "temp_folder.h"
+
+namespace nrslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
+  const fs::path folder = UniqueTempFolder("nrslam_install");
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  const fs::path prefix = folder / "prefix";
+  const std::string cmake = Quoted(NRSLAM_CMAKE_COMMAND);
+
+  const auto [install_status, install_log] =
+      RunCaught(cmake + " --install " + Quoted(NRSLAM_BUILD_DIR) + " --prefix " + Quoted(prefix), folder / "install.txt");
+  ASSERT_EQ(install_status, 0) << install_log;
+
+  for (const char* tool : {"nrslam_simulate", "nrslam_preview", "nrslam_run", "nrslam_eval", "nrslam_import",
+                           "nrslam_stereo_gt"}) {
+    EXPECT_TRUE(fs::exists(prefix / "bin" / tool)) << tool;
+  }
+  const fs::path libdir = prefix / NRSLAM_INSTALL_LIBDIR;
+  EXPECT_TRUE(fs::exists(libdir / "libnrslam.a"));
+  EXPECT_TRUE(fs::exists(libdir / "cmake" / "nrslam" / "nrslamConfig.cmake"));
+  EXPECT_TRUE(fs::exists(libdir / "cmake" / "nrslam" / "nrslamConfigVersion.cmake"));
+  EXPECT_TRUE(fs::exists(prefix / "share" / "doc" / "nrslam" / "docs" / "eval.md"));
+  const fs::path library_sources = fs::path(NRSLAM_SOURCE_DIR) / "nrslam";
+  int headers = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(library_sources)) {
+    if (entry.path().extension() != ".h") continue;
+    ++headers;
+    EXPECT_TRUE(fs::exists(prefix / "include" / "nrslam" / fs::relative(entry.path(), library_sources)))
+        << entry.path() << " was not installed";
+  }
+  EXPECT_GT(headers, 50);
+
+  // The consumer sees nothing of the source or build tree: only the prefix.
+  const fs::path consumer = folder / "consumer";
+  const auto [configure_status, configure_log] =
+      RunCaught(cmake + " -S " + Quoted(fs::path(NRSLAM_SOURCE_DIR) / "tests" / "install_consumer") + " -B " +
+                    Quoted(consumer) + " -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + Quoted(prefix) +
+                    " -DCMAKE_CXX_COMPILER=" + Quoted(NRSLAM_CXX_COMPILER),
+                folder / "configure.txt");
+  ASSERT_EQ(configure_status, 0) << configure_log;
+  EXPECT_NE(configure_log.find("nrslam headers installed: " + std::to_string(headers)), std::string::npos)
+      << configure_log;
+  const auto [build_status, build_log] = RunCaught(cmake + " --build " + Quoted(consumer) + " -j2", folder / "build.txt");
+  ASSERT_EQ(build_status, 0) << build_log;
+
+  const auto [run_status, run_output] =
+      RunCaught(Quoted(consumer / "track_simulated") + " " + Quoted(folder / "work"), folder / "run.txt");
+  EXPECT_EQ(run_status, 0) << run_output;
+  EXPECT_NE(run_output.find(VersionString()), std::string::npos) << run_output;  // this build's library
+  EXPECT_NE(run_output.find("status ok, tracked 12/12"), std::string::npos) << run_output;
+  std::ifstream summary_file(folder / "work" / "run" / "summary.json");
+  ASSERT_TRUE(summary_file) << "the consumer's run wrote no summary";
+  const double rmse_mm = nlohmann::json::parse(summary_file).at("rmse_mm").get<double>();
+  EXPECT_TRUE(std::isfinite(rmse_mm) && rmse_mm > 0.0 && rmse_mm < 2.0) << rmse_mm;
+
+  // The installed tools find each other (nrslam_eval starts nrslam_simulate and nrslam_run beside
+  // itself) and the shipped manifests.
+  const auto [eval_status, eval_output] =
+      RunCaught(Quoted(prefix / "bin" / "nrslam_eval") + " " +
+                    Quoted(prefix / "share" / "nrslam" / "data_manifests" / "ci-sim.json") + " --only sim-0 --out " +
+                    Quoted(folder / "eval") + " --cache " + Quoted(folder / "cache"),
+                folder / "eval.txt");
+  EXPECT_EQ(eval_status, 0) << eval_output;
+  EXPECT_NE(eval_output.find("60/60"), std::string::npos) << eval_output;
+  EXPECT_TRUE(fs::exists(folder / "eval" / "results.csv"));
+  fs::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace nrslam
