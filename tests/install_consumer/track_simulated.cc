@@ -4,6 +4,7 @@
 #include <nrslam/sim/sim_options.h>
 #include <nrslam/sim/simulate.h>
 #include <nrslam/system/run_sequence.h>
+#include <nrslam/system/system_options.h>
 #include <nrslam/util/error.h>
 #include <nrslam/util/source_revision.h>
 
@@ -23,10 +24,8 @@ int main(int argc, char** argv) {
     simulation.camera.height = 240;
     nrslam::SimulateSequence(simulation, "sim-3", work / "sequence");
 
-    nrslam::SystemOptions options;
-    options.run.init = "depth";
-    options.run.mapping = false;
-    options.Check();
+    const nrslam::SystemOptions options =
+        nrslam::WithRunAssignments(nrslam::SystemOptions{}, {"run.init=depth", "run.mapping=false"});
     const nrslam::RunSummary summary = nrslam::RunSequence(work / "sequence", options, work / "run");
     std::cout << nrslam::VersionString() << "\nstatus " << summary.Status() << ", tracked "
               << summary.frames_tracked << "/" << summary.frames_total << ", RMSE " << summary.rmse_mm << " mm\n";
