@@ -15,6 +15,7 @@
 #include <optional>
 #include <thread>
 
+#include "documentation_footer.h"
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
@@ -114,8 +115,8 @@ void RequestStop(int) { stop_requested = true; }
 int main(int argc, char** argv) {
   CLI::App app{"Evaluate NR-SLAM over a manifest of sequences"};
   app.set_version_flag("--version", nrslam::VersionString());
-  app.footer("Documentation: docs/eval.md in the source tree (manifests, sweeps, scene seeds, "
-             "baselines, comparisons, other systems' output, datasets).");
+  app.footer(DocumentationFooter("docs/eval.md (manifests, sweeps, scene seeds, baselines, comparisons, other "
+                                 "systems' output, datasets)"));
   app.require_subcommand(0, 1);
   std::string manifest_path, out = "runs/eval", cache = "runs/cache", emit_jobs, check_baseline, write_baseline,
       config_path;

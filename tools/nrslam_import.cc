@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "documentation_footer.h"
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
@@ -14,8 +15,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"Import a dataset into the nrslam sequence format"};
   app.set_version_flag("--version", nrslam::VersionString());
-  app.footer("Documentation: docs/eval.md in the source tree, \"Public datasets on your disk\" and "
-             "\"Raw stereo recordings\".");
+  app.footer(DocumentationFooter("docs/eval.md, \"Public datasets on your disk\" and \"Raw stereo recordings\""));
   nrslam::ImportOptions options;
   std::string out;
   app.add_option("--format", options.format, "endomapper-sim, hamlyn, c3vd, images or stereo")->required();

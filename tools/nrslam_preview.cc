@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "documentation_footer.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/eval/error_view.h"
 #include "nrslam/io/sequence_reader.h"
@@ -175,7 +176,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Write a frame of a sequence (colour | depth) as a PNG; with --run, each run's points coloured by "
                "their depth error"};
   app.set_version_flag("--version", nrslam::VersionString());
-  app.footer("Documentation: docs/tracking.md in the source tree, \"Looking at a run\".");
+  app.footer(DocumentationFooter("docs/tracking.md, \"Looking at a run\""));
   std::string sequence, out;
   std::vector<std::string> runs;
   int frame = 0;

@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "documentation_footer.h"
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/progress_line.h"
@@ -12,8 +13,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"Run NR-SLAM over a sequence and write its run folder."};
   app.set_version_flag("--version", nrslam::VersionString());
-  app.footer("Documentation: docs/tracking.md (the runner, the run folder) and docs/mapping.md (the "
-             "monocular system) in the source tree; every option: --print-options.");
+  app.footer(DocumentationFooter("docs/tracking.md (the runner, the run folder) and docs/mapping.md (the monocular "
+                                 "system); every option: --print-options"));
   std::string sequence, out, config_path, init;
   bool rigid = false, no_mapping = false, quiet = false, print_options = false;
   std::vector<std::string> assignments;

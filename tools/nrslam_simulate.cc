@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "documentation_footer.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/util/json_options.h"
@@ -16,8 +17,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"Render simulated endoscopy sequences with exact depth ground truth."};
   app.set_version_flag("--version", nrslam::VersionString());
-  app.footer("Documentation: docs/data.md in the source tree (presets, scene, deformation law, "
-             "sequence format).");
+  app.footer(DocumentationFooter("docs/data.md (presets, scene, deformation law, sequence format)"));
   std::string preset = "sim-0", out, config_path, camera_model;
   bool suite = false, stereo = false, print_options = false, quiet = false;
   int frames = 0, width = 0, height = 0;

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <vector>
 
+#include "documentation_footer.h"
 #include "nrslam/datasets/stereo_depth.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/sequence_writer.h"
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 int main(int argc, char** argv) {
   CLI::App app{"Depth ground truth from the rectified stereo pairs of a sequence"};
   app.set_version_flag("--version", nrslam::VersionString());
-  app.footer("Documentation: docs/eval.md in the source tree, \"Depth from stereo\".");
+  app.footer(DocumentationFooter("docs/eval.md, \"Depth from stereo\""));
   std::string folder;
   std::vector<std::string> assignments;
   bool overwrite = false, quiet = false;
