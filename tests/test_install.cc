@@ -12,6 +12,7 @@
 #include <fstream>
 #include <string>
 
+#include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "shell_command.h"
 #include "temp_folder.h"
@@ -21,17 +22,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Quoted(const fs::path& path) { return "'" + path.string() + "'"; }
-
 TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
   const fs::path folder = UniqueTempFolder("nrslam_install");
   fs::remove_all(folder);
   fs::create_directories(folder);
   const fs::path prefix = folder / "prefix";
-  const std::string cmake = Quoted(NRSLAM_CMAKE_COMMAND);
+  const std::string cmake = NRSLAM_CMAKE_COMMAND;
 
   const auto [install_status, install_log] =
-      RunCaught(cmake + " --install " + Quoted(NRSLAM_BUILD_DIR) + " --prefix " + Quoted(prefix), folder / "install.txt");
+      RunCaught(ShellLine({cmake, "--install", NRSLAM_BUILD_DIR, "--prefix", prefix}), folder / "install.txt");
   ASSERT_EQ(install_status, 0) << install_log;
 
   for (const char* tool : {"nrslam_simulate", "nrslam_preview", "nrslam_run", "nrslam_eval", "nrslam_import",
@@ -56,18 +55,19 @@ TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
   // The consumer sees nothing of the source or build tree: only the prefix.
   const fs::path consumer = folder / "consumer";
   const auto [configure_status, configure_log] =
-      RunCaught(cmake + " -S " + Quoted(fs::path(NRSLAM_SOURCE_DIR) / "tests" / "install_consumer") + " -B " +
-                    Quoted(consumer) + " -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + Quoted(prefix) +
-                    " -DCMAKE_CXX_COMPILER=" + Quoted(NRSLAM_CXX_COMPILER),
+      RunCaught(ShellLine({cmake, "-S", fs::path(NRSLAM_SOURCE_DIR) / "tests" / "install_consumer", "-B", consumer,
+                           "-DCMAKE_BUILD_TYPE=Release", "-DCMAKE_PREFIX_PATH=" + prefix.string(),
+                           "-DCMAKE_CXX_COMPILER=" NRSLAM_CXX_COMPILER}),
                 folder / "configure.txt");
   ASSERT_EQ(configure_status, 0) << configure_log;
   EXPECT_NE(configure_log.find("nrslam headers installed: " + std::to_string(headers)), std::string::npos)
       << configure_log;
-  const auto [build_status, build_log] = RunCaught(cmake + " --build " + Quoted(consumer) + " -j2", folder / "build.txt");
+  const auto [build_status, build_log] =
+      RunCaught(ShellLine({cmake, "--build", consumer, "-j2"}), folder / "build.txt");
   ASSERT_EQ(build_status, 0) << build_log;
 
   const auto [run_status, run_output] =
-      RunCaught(Quoted(consumer / "track_simulated") + " " + Quoted(folder / "work"), folder / "run.txt");
+      RunCaught(ShellLine({consumer / "track_simulated", folder / "work"}), folder / "run.txt");
   EXPECT_EQ(run_status, 0) << run_output;
   EXPECT_NE(run_output.find(VersionString()), std::string::npos) << run_output;  // this build's library
   EXPECT_NE(run_output.find("status ok, tracked 12/12"), std::string::npos) << run_output;
@@ -79,9 +79,8 @@ TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
   // The installed tools find each other (nrslam_eval starts nrslam_simulate and nrslam_run beside
   // itself) and the shipped manifests.
   const auto [eval_status, eval_output] =
-      RunCaught(Quoted(prefix / "bin" / "nrslam_eval") + " " +
-                    Quoted(prefix / "share" / "nrslam" / "data_manifests" / "ci-sim.json") + " --only sim-0 --out " +
-                    Quoted(folder / "eval") + " --cache " + Quoted(folder / "cache"),
+      RunCaught(ShellLine({prefix / "bin" / "nrslam_eval", prefix / "share" / "nrslam" / "data_manifests" / "ci-sim.json",
+                           "--only", "sim-0", "--out", folder / "eval", "--cache", folder / "cache"}),
                 folder / "eval.txt");
   EXPECT_EQ(eval_status, 0) << eval_output;
   EXPECT_NE(eval_output.find("60/60"), std::string::npos) << eval_output;
