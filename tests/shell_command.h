@@ -3,10 +3,10 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <utility>
+
+#include "file_text.h"
 
 namespace nrslam {
 
@@ -14,8 +14,7 @@ namespace nrslam {
 // what it printed.
 inline std::pair<int, std::string> RunCaught(const std::string& command, const std::filesystem::path& log) {
   const int status = std::system((command + " > " + log.string() + " 2>&1").c_str());
-  std::ifstream stream(log);
-  return {status, std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>())};
+  return {status, FileText(log)};
 }
 
 }  // namespace nrslam

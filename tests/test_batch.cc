@@ -33,6 +33,7 @@
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
+#include "file_text.h"
 #include "shell_command.h"
 #include "temp_folder.h"
 
@@ -777,12 +778,8 @@ TEST(Results, TablesAreWrittenAsMarkdownAndLatex) {
   failed.error = "cannot read rgb/000003.png";
   results.push_back(failed);
   WriteResults(results, folder);
-  const auto contents = [&](const char* name) {
-    std::ifstream in(folder / name);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  const std::string markdown = contents("results.md");
-  const std::string latex = contents("results.tex");
+  const std::string markdown = FileText(folder / "results.md");
+  const std::string latex = FileText(folder / "results.tex");
   EXPECT_EQ(markdown.rfind("| sequence | sweep point | status | init | tracked | RMSE mm |", 0), 0u) << markdown;
   EXPECT_NE(markdown.find("| sim_3 | k=2 D=5 | ok |"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("| 0.707 |"), std::string::npos) << markdown;
@@ -1103,8 +1100,7 @@ TEST(RigidComparison, TheReportPlotsTheRatioAgainstEachNumericSweptValue) {
   for (const RigidComparison& comparison : comparisons) results.insert(results.end(), {comparison.deformable, comparison.rigid});
   const auto page = [&](const std::vector<RigidComparison>& shown) {
     WriteReport(results, shown, {}, folder / "report");
-    std::ifstream file(folder / "report" / "index.html");
-    return std::string((std::istreambuf_iterator<char>(file)), {});
+    return FileText(folder / "report" / "index.html");
   };
   const std::string html = page(comparisons);
   EXPECT_NE(html.find("Rigid / deformable RMSE against amplitude_mm"), std::string::npos);

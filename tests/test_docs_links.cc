@@ -14,19 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "file_text.h"
 #include "temp_folder.h"
 
 namespace {
 namespace fs = std::filesystem;
 
 const fs::path kSourceDir = NRSLAM_SOURCE_DIR;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 struct NumberedLine {
   int number;  // from 1, as an editor counts
@@ -71,7 +65,7 @@ std::set<std::string> Anchors(const fs::path& file) {
   std::set<std::string> anchors;
   std::map<std::string, int> seen;
   static const std::regex heading(R"(^#{1,6}\s+(.*?)\s*$)");
-  for (const NumberedLine& line : ProseLines(ReadText(file))) {
+  for (const NumberedLine& line : ProseLines(nrslam::FileText(file))) {
     std::smatch match;
     if (!std::regex_match(line.text, match, heading)) continue;
     const std::string anchor = HeadingAnchor(match[1].str());
@@ -85,7 +79,7 @@ std::set<std::string> Anchors(const fs::path& file) {
 std::vector<std::string> BrokenLinks(const fs::path& file) {
   std::vector<std::string> broken;
   static const std::regex link(R"(\]\(([^)\s]+)\))");
-  for (const NumberedLine& numbered : ProseLines(ReadText(file))) {
+  for (const NumberedLine& numbered : ProseLines(nrslam::FileText(file))) {
     const std::string& line = numbered.text;
     for (auto it = std::sregex_iterator(line.begin(), line.end(), link); it != std::sregex_iterator(); ++it) {
       const std::string target = (*it)[1].str();
@@ -134,7 +128,7 @@ std::vector<PageMention> NamedDocsPages() {
     }
   }
   for (const fs::path& file : files) {
-    const std::string text = ReadText(file);
+    const std::string text = nrslam::FileText(file);
     for (auto it = std::sregex_iterator(text.begin(), text.end(), page); it != std::sregex_iterator(); ++it) {
       named.push_back({it->str(), file});
     }

@@ -7,14 +7,14 @@
 #include <algorithm>
 #include <filesystem>
 #include <functional>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <regex>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "file_text.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -31,20 +31,13 @@ std::set<std::string> ModuleNames() {
   return names;
 }
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // The modules named in the README's "Depends on ..." sentence ("everything else": all of
 // them), or nullopt when the README or the sentence is missing.
 std::optional<std::set<std::string>> DeclaredDependencies(const std::string& module,
                                                           const std::set<std::string>& modules) {
   const fs::path readme = kLibraryDir / module / "README.md";
   if (!fs::exists(readme)) return std::nullopt;
-  std::string text = ReadFile(readme);
+  std::string text = nrslam::FileText(readme);
   for (char& c : text) {
     if (c == '\n') c = ' ';
   }
@@ -73,7 +66,7 @@ ModuleGraph IncludeGraph(const std::set<std::string>& modules) {
     for (const fs::directory_entry& entry : fs::directory_iterator(kLibraryDir / module)) {
       const std::string extension = entry.path().extension().string();
       if (extension != ".h" && extension != ".cc") continue;
-      const std::string text = ReadFile(entry.path());
+      const std::string text = nrslam::FileText(entry.path());
       for (std::sregex_iterator it(text.begin(), text.end(), include_line), end; it != end; ++it) {
         if ((*it)[1] != module) graph[module].insert((*it)[1]);
       }

@@ -6,9 +6,9 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "camera_fixtures.h"
+#include "file_text.h"
 #include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/sim/renderer.h"
@@ -18,11 +18,6 @@
 namespace nrslam {
 namespace {
 namespace fs = std::filesystem;
-
-std::string FileBytes(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(file), {});
-}
 
 SimOptions Small(const std::string& preset) {
   SimOptions options = SimPreset(preset);
@@ -46,13 +41,13 @@ TEST(SimRender, SameSeedAndOptionsGiveIdenticalFiles) {
     if (!entry.is_regular_file()) continue;
     const fs::path relative = fs::relative(entry.path(), base / "a");
     if (relative == "sequence.json") continue;  // records the thread count
-    EXPECT_EQ(FileBytes(entry.path()), FileBytes(base / "b" / relative)) << relative;
+    EXPECT_EQ(FileText(entry.path()), FileText(base / "b" / relative)) << relative;
     ++files;
   }
   EXPECT_EQ(files, 3 * 3 + 1);  // rgb, depth, right per frame + groundtruth.tum
   options.seed = 8;
   SimulateSequence(options, "a", base / "c");
-  EXPECT_NE(FileBytes(base / "a" / "rgb" / "000001.png"), FileBytes(base / "c" / "rgb" / "000001.png"));
+  EXPECT_NE(FileText(base / "a" / "rgb" / "000001.png"), FileText(base / "c" / "rgb" / "000001.png"));
   fs::remove_all(base);
 }
 

@@ -3,28 +3,22 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/text_file.h"
+#include "file_text.h"
 #include "temp_folder.h"
 
 namespace nrslam {
 namespace {
-
-std::string Contents(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 TEST(TextFile, ReplacesTheWholeFileAndLeavesNothingElse) {
   const auto folder = UniqueTempFolder("text_file");
   std::filesystem::create_directories(folder);
   WriteTextFile(folder / "results.csv", "a,b\n1,2\n3,4\n");
   WriteTextFile(folder / "results.csv", "a,b\n5,6\n");
-  EXPECT_EQ(Contents(folder / "results.csv"), "a,b\n5,6\n");
+  EXPECT_EQ(FileText(folder / "results.csv"), "a,b\n5,6\n");
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder), {}), 1);  // no temporary left
   std::filesystem::remove_all(folder);
 }
