@@ -15,6 +15,11 @@ install(TARGETS nrslam EXPORT nrslamTargets
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/nrslam/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/nrslam
         FILES_MATCHING PATTERN "*.h")
+# A shared build (-DBUILD_SHARED_LIBS=ON): the installed programs find libnrslam.so relative to
+# themselves, wherever the prefix is.
+if(BUILD_SHARED_LIBS)
+  set_target_properties(${NRSLAM_TOOLS} PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
+endif()
 install(TARGETS ${NRSLAM_TOOLS} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data_manifests DESTINATION ${CMAKE_INSTALL_DATADIR}/nrslam)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})

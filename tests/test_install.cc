@@ -1,8 +1,8 @@
 // Tests: the installation (cmake/NrslamInstall.cmake). nrslam is installed into a temporary
 // prefix and used from there alone, as by someone who builds on it: another CMake project
 // (tests/install_consumer) finds the package, compiles every installed header, links the library
-// and tracks a sequence with it, and the installed nrslam_eval runs a manifest from the
-// installed share folder.
+// into a program and into a plugin and tracks a sequence with each, and the installed nrslam_eval
+// runs a manifest from the installed share folder.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +23,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The RMSE of the consumer's run in WORK (NaN when it wrote no summary).
+double SummaryRmse(const fs::path& work) {
+  std::ifstream summary(work / "run" / "summary.json");
+  if (!summary) return std::nan("");
+  return nlohmann::json::parse(summary).at("rmse_mm").get<double>();
+}
+
 TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
   const fs::path folder = UniqueTempFolder("nrslam_install");
   fs::remove_all(folder);
@@ -39,7 +46,7 @@ TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
   for (std::string tool; tools >> tool; ++tool_count) EXPECT_TRUE(fs::exists(prefix / "bin" / tool)) << tool;
   EXPECT_GE(tool_count, 6);
   const fs::path libdir = prefix / NRSLAM_INSTALL_LIBDIR;
-  EXPECT_TRUE(fs::exists(libdir / "libnrslam.a"));
+  EXPECT_TRUE(fs::exists(libdir / NRSLAM_LIBRARY_FILE_NAME));  // libnrslam.a, or .so in a shared build
   EXPECT_TRUE(fs::exists(libdir / "cmake" / "nrslam" / "nrslamConfig.cmake"));
   EXPECT_TRUE(fs::exists(libdir / "cmake" / "nrslam" / "nrslamConfigVersion.cmake"));
   EXPECT_TRUE(fs::exists(prefix / "share" / "doc" / "nrslam" / "docs" / "eval.md"));
@@ -72,10 +79,17 @@ TEST(Install, AnotherProjectBuildsOnTheInstalledLibraryAndTracksWithIt) {
   EXPECT_EQ(run_status, 0) << run_output;
   EXPECT_NE(run_output.find(VersionString()), std::string::npos) << run_output;  // this build's library
   EXPECT_NE(run_output.find("status ok, tracked 12/12"), std::string::npos) << run_output;
-  std::ifstream summary_file(folder / "work" / "run" / "summary.json");
-  ASSERT_TRUE(summary_file) << "the consumer's run wrote no summary";
-  const double rmse_mm = nlohmann::json::parse(summary_file).at("rmse_mm").get<double>();
+  const double rmse_mm = SummaryRmse(folder / "work");
   EXPECT_TRUE(std::isfinite(rmse_mm) && rmse_mm > 0.0 && rmse_mm < 2.0) << rmse_mm;
+
+  // The same job from a shared object loaded at run time, as a Python extension module would be:
+  // the library links into one (position-independent code) and leaves nothing unresolved.
+  const auto [plugin_status, plugin_output] =
+      RunCaught(ShellLine({consumer / "load_plugin", consumer / "track_plugin.so", folder / "work_plugin"}),
+                folder / "plugin.txt");
+  EXPECT_EQ(plugin_status, 0) << plugin_output;
+  EXPECT_NE(plugin_output.find("status ok, tracked 12/12"), std::string::npos) << plugin_output;
+  EXPECT_EQ(SummaryRmse(folder / "work_plugin"), rmse_mm);  // the same code, the same run to the last bit
 
   // The installed tools find each other (nrslam_eval starts nrslam_simulate and nrslam_run beside
   // itself) and the shipped manifests.

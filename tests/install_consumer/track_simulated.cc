@@ -1,37 +1,12 @@
-// A user's program on the installed library: renders a short simulated colonoscopy, tracks it
-// from its first depth map (the paper's tracking experiment) and prints how the run went.
-// Usage: track_simulated WORK_FOLDER. Exit 0 when every frame was tracked.
-#include <nrslam/sim/sim_options.h>
-#include <nrslam/sim/simulate.h>
-#include <nrslam/system/run_sequence.h>
-#include <nrslam/system/system_options.h>
-#include <nrslam/util/error.h>
-#include <nrslam/util/source_revision.h>
-
-#include <filesystem>
+// A user's program on the installed library. Usage: track_simulated WORK_FOLDER.
 #include <iostream>
+
+#include "track_simulated_job.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::cerr << "usage: track_simulated WORK_FOLDER\n";
     return 2;
   }
-  try {
-    const std::filesystem::path work = argv[1];
-    nrslam::SimOptions simulation = nrslam::SimPreset("sim-3");
-    simulation.frames = 12;
-    simulation.camera.width = 320;
-    simulation.camera.height = 240;
-    nrslam::SimulateSequence(simulation, "sim-3", work / "sequence");
-
-    const nrslam::SystemOptions options =
-        nrslam::WithRunAssignments(nrslam::SystemOptions{}, {"run.init=depth", "run.mapping=false"});
-    const nrslam::RunSummary summary = nrslam::RunSequence(work / "sequence", options, work / "run");
-    std::cout << nrslam::VersionString() << "\nstatus " << summary.Status() << ", tracked "
-              << summary.frames_tracked << "/" << summary.frames_total << ", RMSE " << summary.rmse_mm << " mm\n";
-    return summary.Status() == "ok" && summary.frames_tracked == summary.frames_total ? 0 : 1;
-  } catch (const nrslam::Error& error) {
-    std::cerr << "error: " << error.what() << "\n";
-    return 1;
-  }
+  return TrackSimulatedSequence(argv[1]);
 }
