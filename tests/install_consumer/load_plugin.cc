@@ -1,7 +1,8 @@
 // Loads a shared object that carries the library, as Python loads an extension module, and runs
-// its job. The plugin is linked with the static libnrslam.a (or against libnrslam.so), so this
-// fails to build when the library is not position-independent, and fails to load when the plugin
-// leaves one of the library's symbols or dependencies unresolved (RTLD_NOW resolves all of them).
+// its job. The plugin (track_plugin) takes in the static libnrslam.a, or links libnrslam.so in a
+// shared build: its link fails when the library is not position-independent, and loading it here
+// fails when it leaves one of the library's symbols or dependencies unresolved (RTLD_NOW resolves
+// all of them at once).
 // Usage: load_plugin PLUGIN WORK_FOLDER.
 #include <dlfcn.h>
 
