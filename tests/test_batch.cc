@@ -693,8 +693,7 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   // The report's section of the run says the same.
   const auto folder = UniqueTempFolder("results_notes_report");
   WriteReport({damaged, fine}, {}, {}, folder / "report");
-  std::ifstream report(folder / "report" / "index.html");
-  const std::string html((std::istreambuf_iterator<char>(report)), {});
+  const std::string html = FileText(folder / "report" / "index.html");
   EXPECT_NE(html.find("<p>3 frames skipped as image dropouts (lost; the map kept)</p>"), std::string::npos) << html;
   std::filesystem::remove_all(folder);
   const std::vector<RunResult> read = ResultsFromJson(ToJson({damaged, fine}));
@@ -1390,8 +1389,7 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
   // and the failed sequence is shown as such.
   WriteReport(results, comparisons, GroupBySeed(plan, results), folder / "out" / "report");
   {
-    std::ifstream report(folder / "out" / "report" / "index.html");
-    const std::string html((std::istreambuf_iterator<char>(report)), {});
+    const std::string html = FileText(folder / "out" / "report" / "index.html");
     EXPECT_NE(html.find("<p>Code: " + DescribeRevisions(results) + "</p>"), std::string::npos);
   }
   if (std::system("chromium --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "chromium is not installed";
@@ -1401,9 +1399,8 @@ TEST(BatchEvaluation, ABrokenSequenceIsReportedAndTheOthersStillRun) {
                          (folder / "out" / "report" / "index.html").string() + " > " + dom + " 2> " + log)
                             .c_str()),
             0);
-  std::ifstream dom_stream(dom), log_stream(log);
-  const std::string page((std::istreambuf_iterator<char>(dom_stream)), {});
-  const std::string browser((std::istreambuf_iterator<char>(log_stream)), {});
+  const std::string page = FileText(dom);
+  const std::string browser = FileText(log);
   // Two tracked runs: each an RMSE plot (the run and the flat map), a drift plot (scale and
   // median depth), a trajectory plot (two series) and three images.
   EXPECT_NE(page.find("data-check=\"images=6 broken=0 plots=6 series=12\""), std::string::npos)
@@ -1947,8 +1944,7 @@ TEST(BatchEvaluation, EmittedJobsRunByGnuParallelThenMerged) {
   ASSERT_EQ(std::system((eval + " " + manifest.string() + common + " --emit-jobs " + (folder / "jobs.txt").string() +
                          " > /dev/null").c_str()),
             0);
-  std::ifstream jobs(folder / "jobs.txt");
-  const std::string text((std::istreambuf_iterator<char>(jobs)), {});
+  const std::string text = FileText(folder / "jobs.txt");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
   // Four jobs, two at a time; both renders of the one preset race for the same cache folder.
   ASSERT_EQ(std::system(("parallel --will-cite -j2 < " + (folder / "jobs.txt").string() + " > /dev/null 2>&1").c_str()), 0);
@@ -2055,8 +2051,7 @@ TEST(BatchEvaluation, TwoEvaluationsIntoOneFolderAreRefused) {
     const FolderLock running(folder / "out", "an evaluation still running");
     EXPECT_THROW(FolderLock(folder / "out", "a second one"), Error);
     EXPECT_NE(std::system(evaluation.c_str()), 0);
-    std::ifstream log(folder / "log.txt");
-    const std::string text((std::istreambuf_iterator<char>(log)), {});
+    const std::string text = FileText(folder / "log.txt");
     EXPECT_NE(text.find("is in use by another process (an evaluation still running, pid " + std::to_string(::getpid()) +
                         ", or a process it started)"),
               std::string::npos)

@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "camera_fixtures.h"
+#include "file_text.h"
 #include "temp_folder.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/run_folder.h"
@@ -479,12 +480,7 @@ TEST_F(RunSequenceTest, SavedConfigRepeatsTheRun) {
   const RunSummary repeated = RunSequence(*base_ / "sequence", loaded, *base_ / "repeated");
   EXPECT_EQ(repeated.frames_tracked, summary_->frames_tracked);
   EXPECT_EQ(repeated.rmse_mm, summary_->rmse_mm);
-  const auto text = [](const fs::path& file) {
-    std::ostringstream content;
-    content << std::ifstream(file).rdbuf();
-    return content.str();
-  };
-  EXPECT_EQ(text(*base_ / "repeated" / "trajectory.tum"), text(*base_ / "run" / "trajectory.tum"));
+  EXPECT_EQ(FileText(*base_ / "repeated" / "trajectory.tum"), FileText(*base_ / "run" / "trajectory.tum"));
 }
 
 // A run into the folder of an earlier, longer run leaves nothing of that run behind (a stale
@@ -696,8 +692,8 @@ TEST_F(RunSequenceTest, RunFolderHoldsEveryOutput) {
   EXPECT_TRUE(std::regex_match(code, std::regex("[0-9a-f]{12}"))) << code;
   EXPECT_EQ(ReadTum(run / "trajectory.tum").size(), 40u);
   EXPECT_TRUE(fs::exists(run / "depth" / "000039.png"));
-  std::ifstream metrics(run / "metrics.csv");
-  EXPECT_EQ(std::count(std::istreambuf_iterator<char>(metrics), {}, '\n'), 41);  // header + one per frame
+  const std::string metrics = FileText(run / "metrics.csv");
+  EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 41);  // header + one per frame
   // The solver timings are parts of the deformation stage's, which is what they break down.
   const double deformation = SumColumn(run / "metrics.csv", "ms_deformation");
   const double joint_solve = SumColumn(run / "metrics.csv", "ms_joint_solve");
@@ -1605,8 +1601,7 @@ TEST_F(RunSequenceTest, AnOnScreenDisplayIsLeftOutNotTracked) {
   result.input.static_fraction = left_out.input.static_fraction;
   result.run_folder = (folder / "left_out").string();
   WriteReport({result}, {}, {}, folder / "report");
-  std::ifstream page(folder / "report" / "index.html");
-  const std::string html((std::istreambuf_iterator<char>(page)), {});
+  const std::string html = FileText(folder / "report" / "index.html");
   EXPECT_NE(html.find("what the run left out as never changing"), std::string::npos);
   EXPECT_NE(html.find("never changed (an on-screen display"), std::string::npos);
   EXPECT_TRUE(fs::exists(folder / "report" / "display_static.png"));

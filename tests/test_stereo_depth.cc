@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iterator>
 
 #include "nrslam/datasets/stereo_depth.h"
@@ -12,6 +11,7 @@
 #include "nrslam/sim/renderer.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
+#include "file_text.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -109,10 +109,9 @@ TEST(StereoDepth, ToolWritesTheSequencesDepth) {
   EXPECT_NE(std::system((tools + "/nrslam_stereo_gt --quiet --overwrite " + (folder / "seq").string() + " > " +
                          (folder / "distorted.log").string() + " 2>&1").c_str()),
             0);
-  std::ostringstream log;
-  log << std::ifstream(folder / "distorted.log").rdbuf();
-  EXPECT_NE(log.str().find("needs a rectified pair with a pinhole camera"), std::string::npos) << log.str();
-  EXPECT_NE(log.str().find("nrslam_import --format stereo"), std::string::npos) << log.str();  // the way out
+  const std::string log = FileText(folder / "distorted.log");
+  EXPECT_NE(log.find("needs a rectified pair with a pinhole camera"), std::string::npos) << log;
+  EXPECT_NE(log.find("nrslam_import --format stereo"), std::string::npos) << log;  // the way out
   // A mono sequence is refused with a message, not a crash.
   ASSERT_EQ(std::system((tools + "/nrslam_simulate --preset sim-0 --frames 2 --width 160 --height 120 --quiet --out " +
                          (folder / "mono").string() + " > /dev/null").c_str()),
