@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "file_text.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 

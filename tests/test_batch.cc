@@ -32,8 +32,8 @@
 #include "nrslam/util/folder_lock.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
-#include "file_text.h"
 #include "shell_command.h"
 #include "temp_folder.h"
 

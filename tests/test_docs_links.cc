@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "file_text.h"
+#include "nrslam/util/text_file.h"
 #include "temp_folder.h"
 
 namespace {

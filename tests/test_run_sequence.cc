@@ -21,7 +21,6 @@
 #include <sstream>
 
 #include "camera_fixtures.h"
-#include "file_text.h"
 #include "temp_folder.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/run_folder.h"
@@ -42,6 +41,7 @@
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/source_revision.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace {

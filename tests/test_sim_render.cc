@@ -8,12 +8,12 @@
 #include <fstream>
 
 #include "camera_fixtures.h"
-#include "file_text.h"
 #include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace {

@@ -11,7 +11,7 @@
 #include "nrslam/sim/renderer.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
-#include "file_text.h"
+#include "nrslam/util/text_file.h"
 #include "temp_folder.h"
 
 namespace nrslam {

@@ -1,5 +1,5 @@
 // A whole text file is written whole or not at all, and a file that cannot be written is an
-// error rather than a silently missing or short one.
+// error rather than a silently missing or short one. Read whole, it comes back byte for byte.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,7 +8,6 @@
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/text_file.h"
-#include "file_text.h"
 #include "temp_folder.h"
 
 namespace nrslam {
@@ -34,6 +33,19 @@ TEST(TextFile, AFileThatCannotBeWrittenIsAnError) {
     EXPECT_NE(std::string(e.what()).find("cannot write " + (folder / "results.json").string()), std::string::npos)
         << e.what();
   }
+  std::filesystem::remove_all(folder);
+}
+
+TEST(TextFile, ReadsEveryByteAsWrittenAndNothingFromAMissingFile) {
+  const auto folder = UniqueTempFolder("text_file_read");
+  std::filesystem::create_directories(folder);
+  // Line ends, a NUL and no final newline: nothing translated, nothing cut at the NUL.
+  const std::string bytes = std::string("line\r\nnul:") + '\0' + "end";
+  WriteTextFile(folder / "log.txt", bytes);
+  EXPECT_EQ(FileText(folder / "log.txt"), bytes);
+  EXPECT_EQ(FileText(folder / "log.txt").size(), 14u);
+  EXPECT_EQ(FileText(folder / "absent.txt"), "");
+  EXPECT_EQ(FileText(folder), "");  // a folder is not a file's text
   std::filesystem::remove_all(folder);
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace {
@@ -69,13 +70,6 @@ std::pair<std::string, cv::FileNode> FirstEntry(const cv::FileNode& map, std::in
 std::string Lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
   return text;
-}
-
-std::string FileText(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
 }
 
 bool IsOpenCvCalibration(const std::filesystem::path& file, char first) {

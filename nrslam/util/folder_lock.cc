@@ -6,10 +6,9 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 
@@ -25,8 +24,7 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& h
     ::close(descriptor_);
     descriptor_ = -1;
     if (reason != EWOULDBLOCK) throw Error("cannot lock " + path.string() + ": " + std::strerror(reason));
-    std::ifstream file(path);
-    const std::string other((std::istreambuf_iterator<char>(file)), {});
+    const std::string other = FileText(path);
     throw Error(folder.string() + " is in use by another process (" + (other.empty() ? "unknown" : other) +
                 ", or a process it started); wait for it to end, or give another output folder");
   }

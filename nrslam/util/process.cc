@@ -12,13 +12,12 @@
 #include <cmath>
 #include <csignal>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <sstream>
 #include <thread>
 
 #include "nrslam/util/memory_usage.h"
+#include "nrslam/util/text_file.h"
 
 extern char** environ;
 
@@ -150,9 +149,7 @@ std::optional<std::string> CommandOutput(const std::vector<std::string>& argv, d
   const std::filesystem::path log = std::filesystem::temp_directory_path() /
                                     ("nrslam-output-" + std::to_string(getpid()) + "-" + std::to_string(calls++));
   const ProcessOutcome outcome = RunCommands({Command{argv, log, timeout_seconds}}, 1).front();
-  std::ifstream stream(log);
-  std::string output((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
-  stream.close();
+  std::string output = FileText(log);
   std::error_code ignored;
   std::filesystem::remove(log, ignored);
   if (!outcome.ok()) return std::nullopt;
@@ -162,8 +159,7 @@ std::optional<std::string> CommandOutput(const std::vector<std::string>& argv, d
 bool ProcessIsRunning(int pid) {
   if (pid <= 0 || (kill(pid, 0) != 0 && errno == ESRCH)) return false;
   // "pid (name) S ...": the state follows the last ')', as the name may hold any character.
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  const std::string line((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const std::string line = FileText("/proc/" + std::to_string(pid) + "/stat");
   const size_t name_end = line.rfind(')');
   return name_end == std::string::npos || name_end + 2 >= line.size() || line[name_end + 2] != 'Z';
 }

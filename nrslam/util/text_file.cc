@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <iterator>
 #include <system_error>
 
 #include "nrslam/util/error.h"
@@ -28,6 +29,13 @@ void WriteTextFile(const std::filesystem::path& path, const std::string& text) {
 void CloseWritten(std::ofstream& file, const std::filesystem::path& path) {
   file.close();
   if (file.fail()) throw Error("cannot write " + path.string() + " (is the disk full?)");
+}
+
+std::string FileText(const std::filesystem::path& path) {
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) return "";  // opens as a file, then throws on reading
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), {});
 }
 
 }  // namespace nrslam

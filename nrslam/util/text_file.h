@@ -1,5 +1,6 @@
-// util: writing a whole text file (a results table, a report, a baseline) so that a reader never
-// finds half of one: a full disk or a missing folder is an error, not a silently short file.
+// util: a whole text file at once. Writing one (a results table, a report, a baseline) so that a
+// reader never finds half of one: a full disk or a missing folder is an error, not a silently
+// short file. Reading one whole (a calibration, a child process's log).
 #pragma once
 
 #include <filesystem>
@@ -16,5 +17,9 @@ void WriteTextFile(const std::filesystem::path& path, const std::string& text);
 // Closes `file`, written piece by piece to `path` (a run's points.csv as its frames come);
 // throws Error naming `path` when any of it could not be written.
 void CloseWritten(std::ofstream& file, const std::filesystem::path& path);
+
+// Every byte of `path`, as written; "" when it cannot be opened or is a folder. For files whose absence the
+// caller handles itself (a log a killed process never wrote, a /proc entry gone with its process).
+std::string FileText(const std::filesystem::path& path);
 
 }  // namespace nrslam
