@@ -92,6 +92,13 @@ void SimulateSmall(const std::string& preset, int frames, int width, int height,
   SimulateSequence(sim, preset + "-small", folder);
 }
 
+// Frames [first, end) of a 320×240 sequence made one flat colour: a blank view (a flush, the
+// lens against the tissue) or, black, the light off.
+void BlankFrames(const fs::path& sequence, int first, int end, const cv::Scalar& colour) {
+  const cv::Mat blank(240, 320, CV_8UC3, colour);
+  for (int frame = first; frame < end; ++frame) cv::imwrite((sequence / "rgb" / FrameFileName(frame)).string(), blank);
+}
+
 class RunSequenceTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -1423,9 +1430,7 @@ TEST(RunSequenceErrors, ASecondMapNumbersItsPointsAfterTheFirst) {
   const fs::path folder = UniqueTempFolder("nrslam_second_map");
   fs::remove_all(folder);
   SimulateSmall("sim-0", 10, 320, 240, folder);
-  for (int frame = 5; frame < 7; ++frame) {
-    cv::imwrite((folder / "rgb" / FrameFileName(frame)).string(), cv::Mat::zeros(240, 320, CV_8UC3));
-  }
+  BlankFrames(folder, 5, 7, cv::Scalar(0, 0, 0));
   SystemOptions options = TrackingExperiment();
   options.run.reinitialise_after_loss = true;
   options.tracking.max_dropout_frames = 0;  // lost on the first black frame, not skipped
@@ -1451,9 +1456,7 @@ TEST(RunSequenceErrors, ABlackedOutViewIsLostWithWhereAndWhy) {
   const fs::path folder = UniqueTempFolder("nrslam_black_end");
   fs::remove_all(folder);
   SimulateSmall("sim-0", 10, 320, 240, folder);
-  for (int frame = 7; frame < 10; ++frame) {
-    cv::imwrite((folder / "rgb" / FrameFileName(frame)).string(), cv::Mat::zeros(240, 320, CV_8UC3));
-  }
+  BlankFrames(folder, 7, 10, cv::Scalar(0, 0, 0));
   SystemOptions options = TrackingExperiment();
   options.tracking.max_dropout_frames = 1;
   const RunSummary stopped = RunSequence(folder, options, folder / "stopped");
@@ -1490,10 +1493,7 @@ void ExpectLostFromFrame(const fs::path& folder, const SystemOptions& options, i
 // as without the gap. Without the skip (the reference), the tracking experiment ends there.
 TEST_F(RunSequenceTest, AShortImageDropoutIsSkippedWithTheMapKept) {
   const fs::path folder = CopyOfSequence("dropout");
-  const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
-  for (int frame = 15; frame < 18; ++frame) {
-    cv::imwrite((folder / "sequence" / "rgb" / FrameFileName(frame)).string(), grey);
-  }
+  BlankFrames(folder / "sequence", 15, 18, cv::Scalar(128, 128, 128));
 
   const RunSummary skipped = RunSequence(folder / "sequence", TrackingExperiment(), folder / "skipped");
   EXPECT_EQ(skipped.Status(), "ok");
