@@ -18,8 +18,9 @@ void WriteTextFile(const std::filesystem::path& path, const std::string& text);
 // throws Error naming `path` when any of it could not be written.
 void CloseWritten(std::ofstream& file, const std::filesystem::path& path);
 
-// Every byte of `path`, as written; "" when it cannot be opened or is a folder. For files whose absence the
-// caller handles itself (a log a killed process never wrote, a /proc entry gone with its process).
+// Every byte of `path`, as written; "" when it cannot be opened or is a folder. For files whose
+// absence the caller handles itself (a log a killed process never wrote, a /proc entry gone with
+// its process).
 std::string FileText(const std::filesystem::path& path);
 
 }  // namespace nrslam
