@@ -160,6 +160,17 @@ TEST_F(SequenceReaderTest, GroundtruthLineCount) {
   EXPECT_ERROR_MENTIONS("groundtruth.tum has 1 poses, expected 40");
 }
 
+// A folder where a file should be opens as a stream on Linux: named as a folder, not read as an
+// empty file (no poses) or failed with the C library's "Is a directory" and no file name.
+TEST_F(SequenceReaderTest, AFolderInPlaceOfAFileIsNamed) {
+  fs::remove(folder_ / "groundtruth.tum");
+  fs::create_directory(folder_ / "groundtruth.tum");
+  EXPECT_ERROR_MENTIONS((folder_ / "groundtruth.tum").string() + " is a folder, not a TUM trajectory file");
+  fs::remove(folder_ / "sequence.json");
+  fs::create_directory(folder_ / "sequence.json");
+  EXPECT_ERROR_MENTIONS((folder_ / "sequence.json").string() + " is a folder, not a JSON file");
+}
+
 TEST_F(SequenceReaderTest, GroundtruthNaN) {
   std::ofstream(folder_ / "groundtruth.tum") << "0 nan 0 0 0 0 0 1\n";
   EXPECT_ERROR_MENTIONS("groundtruth.tum:1: non-finite value");

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <iterator>
 #include <string>
 
@@ -46,6 +47,27 @@ TEST(TextFile, ReadsEveryByteAsWrittenAndNothingFromAMissingFile) {
   EXPECT_EQ(FileText(folder / "log.txt").size(), 14u);
   EXPECT_EQ(FileText(folder / "absent.txt"), "");
   EXPECT_EQ(FileText(folder), "");  // a folder is not a file's text
+  std::filesystem::remove_all(folder);
+}
+
+TEST(TextFile, OpensToReadOrSaysWhyNot) {
+  const auto folder = UniqueTempFolder("text_file_open");
+  std::filesystem::create_directories(folder);
+  WriteTextFile(folder / "points.csv", "frame,u\n0,1\n");
+  std::ifstream file = OpenToRead(folder / "points.csv", "CSV file");
+  std::string header;
+  EXPECT_TRUE(std::getline(file, header));
+  EXPECT_EQ(header, "frame,u");
+  auto message = [](const std::filesystem::path& path) {
+    try {
+      OpenToRead(path, "CSV file");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("opened");
+  };
+  EXPECT_EQ(message(folder / "absent.csv"), "cannot open " + (folder / "absent.csv").string());
+  EXPECT_EQ(message(folder), folder.string() + " is a folder, not a CSV file");
   std::filesystem::remove_all(folder);
 }
 

@@ -3,7 +3,6 @@
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 #include "documentation_footer.h"
@@ -47,9 +46,7 @@ int main(int argc, char** argv) {
     auto resolve = [&](const std::string& name) {
       nrslam::SimOptions options = nrslam::SimPreset(name);
       if (!config_path.empty()) {
-        std::ifstream file(config_path);
-        if (!file) throw nrslam::Error("cannot read " + config_path);
-        options = nrslam::OptionsFromJson(nrslam::Json::parse(file), config_path, options);
+        options = nrslam::OptionsFromJson(nrslam::ReadJsonFile(config_path), config_path, options);
       }
       if (frames_given->count()) options.frames = frames;
       if (width_given->count()) options.camera.width = width;

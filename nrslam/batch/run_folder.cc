@@ -8,12 +8,12 @@
 #include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 
 std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw Error("cannot read " + file.string());
+  std::ifstream stream = OpenToRead(file, "CSV file");
   std::vector<std::string> header, fields;
   std::vector<std::map<std::string, std::string>> rows;
   int line = 0;

@@ -3,12 +3,12 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <fstream>
 #include <sstream>
 
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/io/png_header.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -76,15 +76,8 @@ SequenceReader::SequenceReader(const fs::path& folder) : folder_(folder) {
   if (!fs::is_directory(folder)) throw Error("sequence folder " + folder.string() + " does not exist");
   const fs::path json_path = folder / "sequence.json";
   if (!fs::exists(json_path)) throw Error("sequence " + folder.string() + ": missing sequence.json");
-  nlohmann::json json;
   try {
-    std::ifstream file(json_path);
-    json = nlohmann::json::parse(file);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error("sequence " + folder.string() + ": sequence.json is not valid JSON: " + e.what());
-  }
-  try {
-    info_ = json.get<SequenceInfo>();
+    info_ = ReadJsonFile(json_path).get<SequenceInfo>();
   } catch (const Error& e) {
     throw Error("sequence " + folder.string() + ": " + e.what());
   }

@@ -25,8 +25,7 @@ void WriteTum(const std::filesystem::path& path, const std::vector<StampedPose>&
 }
 
 std::vector<StampedPose> ReadTum(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  if (!file) throw Error("cannot read " + path.string());
+  std::ifstream file = OpenToRead(path, "TUM trajectory file");
   std::vector<StampedPose> poses;
   std::string line;
   for (int line_number = 1; std::getline(file, line); ++line_number) {

@@ -54,8 +54,7 @@ void CheckFrame(double frame, int frame_count, const std::string& where) {
 
 // `has_point_ids`: whether the file has its own point_id column (else ids number rows).
 FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_point_ids) {
-  std::ifstream in(file);
-  if (!in) throw Error("cannot read " + file.string());
+  std::ifstream in = OpenToRead(file, "CSV file");
   int line = 0;
   std::vector<std::string> header, fields;
   if (!ReadCsvRecord(in, file.string(), &line, &header)) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
 namespace nrslam {
@@ -224,10 +225,7 @@ void ApplyAssignment(Json& config, const std::string& assignment) {
 }
 
 Json ReadJsonFile(const std::filesystem::path& file) {
-  // A folder opens as a stream on Linux and fails only when read, with the C library's words.
-  if (std::filesystem::is_directory(file)) throw Error(file.string() + " is a folder, not a JSON file");
-  std::ifstream stream(file);
-  if (!stream) throw Error("cannot open " + file.string());
+  std::ifstream stream = OpenToRead(file, "JSON file");
   try {
     return Json::parse(stream);
   } catch (const Json::exception& e) {

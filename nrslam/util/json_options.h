@@ -37,7 +37,8 @@ std::string Assignment(const std::string& path, const Json& value);
 // applied to `base` they give `changed`. Both must have the same keys.
 std::vector<std::string> ChangedAssignments(const Json& base, const Json& changed);
 
-// Parses a JSON file; throws Error "cannot open FILE" or "FILE is not valid JSON (why)".
+// Parses a JSON file; throws Error "cannot open FILE", "FILE is a folder, not a JSON file" or "FILE
+// is not valid JSON (why)".
 Json ReadJsonFile(const std::filesystem::path& file);
 
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.

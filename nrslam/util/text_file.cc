@@ -31,6 +31,14 @@ void CloseWritten(std::ofstream& file, const std::filesystem::path& path) {
   if (file.fail()) throw Error("cannot write " + path.string() + " (is the disk full?)");
 }
 
+std::ifstream OpenToRead(const std::filesystem::path& path, const std::string& kind) {
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) throw Error(path.string() + " is a folder, not a " + kind);
+  std::ifstream file(path);
+  if (!file) throw Error("cannot open " + path.string());
+  return file;
+}
+
 std::string FileText(const std::filesystem::path& path) {
   std::error_code ignored;
   if (std::filesystem::is_directory(path, ignored)) return "";  // opens as a file, then throws on reading
