@@ -145,6 +145,12 @@ TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
 
   fs::remove(in / "image02" / "0000000001.png");
   EXPECT_NE(ImportError(options, out).find("image02/ has 2 images, image01/ 3"), std::string::npos);
+  HamlynFixture(in, [](int i) { return cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)); });
+  fs::remove(in / "intrinsics.txt");
+  EXPECT_NE(ImportError(options, out).find("missing intrinsics.txt"), std::string::npos);
+  fs::create_directory(in / "intrinsics.txt");  // opens as a stream, then reads as nothing
+  EXPECT_NE(ImportError(options, out).find((in / "intrinsics.txt").string() + " is a folder, not a text file"),
+            std::string::npos);
   fs::remove_all(in);
   fs::remove_all(out);
 }

@@ -21,6 +21,7 @@
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/text_file.h"
 
 namespace nrslam {
 namespace fs = std::filesystem;
@@ -41,6 +42,17 @@ struct FrameSource {
 
 [[noreturn]] void Fail(const ImportOptions& options, const std::string& message) {
   throw Error(options.format + " dataset " + options.input.string() + ": " + message);
+}
+
+// A text file of the dataset (poses, intrinsics), opened to read; Fail when it is missing or a
+// folder has its name.
+std::ifstream OpenText(const ImportOptions& options, const std::string& name) {
+  if (!fs::exists(options.input / name)) Fail(options, "missing " + name);
+  try {
+    return OpenToRead(options.input / name, "text file");
+  } catch (const Error& e) {
+    Fail(options, e.what());
+  }
 }
 
 cv::Mat ReadImage(const ImportOptions& options, const fs::path& file, int flags) {
@@ -141,8 +153,7 @@ FrameSource EndomapperSim(const ImportOptions& options) {
     }
     return depth;
   };
-  std::ifstream trajectory(options.input / "trajectory.csv");
-  if (!trajectory) Fail(options, "missing trajectory.csv");
+  std::ifstream trajectory = OpenText(options, "trajectory.csv");
   std::string line;
   std::getline(trajectory, line);  // header
   for (int row = 2; std::getline(trajectory, line); ++row) {
@@ -170,8 +181,7 @@ FrameSource Hamlyn(const ImportOptions& options) {
     Fail(options, "depth01/ has " + std::to_string(depth.size()) + " images, image01/ " + std::to_string(left.size()));
   }
   source.count = static_cast<int>(left.size());
-  std::ifstream intrinsics(options.input / "intrinsics.txt");
-  if (!intrinsics) Fail(options, "missing intrinsics.txt");
+  std::ifstream intrinsics = OpenText(options, "intrinsics.txt");
   std::vector<double> numbers;
   std::string line;
   while (std::getline(intrinsics, line)) {
@@ -222,8 +232,7 @@ FrameSource C3vd(const ImportOptions& options) {
     raw.convertTo(mm, CV_32F, 100.0 / 65535.0);
     return mm;
   };
-  std::ifstream poses(options.input / "pose.txt");
-  if (!poses) Fail(options, "missing pose.txt");
+  std::ifstream poses = OpenText(options, "pose.txt");
   std::string line;
   for (int row = 1; std::getline(poses, line); ++row) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
