@@ -1,5 +1,6 @@
 // A whole text file is written whole or not at all, and a file that cannot be written is an
-// error rather than a silently missing or short one. Read whole, it comes back byte for byte.
+// error rather than a silently missing or short one. Read whole, it comes back byte for byte;
+// opened to read, a folder in its place is named as one.
 #include <gtest/gtest.h>
 
 #include <filesystem>
