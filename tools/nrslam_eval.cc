@@ -27,6 +27,7 @@
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/folder_lock.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
@@ -242,7 +243,7 @@ int main(int argc, char** argv) {
       std::cout << nrslam::DescribePlan(plan);
       return 0;
     }
-    std::filesystem::create_directories(out);
+    nrslam::CreateFolder(out);
     if (!emit_jobs.empty()) {
       std::string jobs_text;
       for (const nrslam::RunJob& run : plan.runs) jobs_text += nrslam::RunShellLine(plan, run, programs) + '\n';

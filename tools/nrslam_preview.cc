@@ -22,6 +22,7 @@
 #include "nrslam/eval/error_view.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_table.h"
@@ -238,7 +239,7 @@ int main(int argc, char** argv) {
       }
       if (black.empty()) throw nrslam::Error("no frame of the sequence could be drawn");
     } else {
-      fs::create_directories(out);
+      nrslam::CreateFolder(out);
       for (int index = 0; index < preview.frame_count(); ++index) {
         char name[16];
         std::snprintf(name, sizeof(name), "%06d.png", index);

@@ -15,6 +15,7 @@
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/process.h"
 #include "nrslam/util/source_revision.h"
@@ -59,7 +60,7 @@ std::vector<std::string> SplitList(const std::string& text) {
 }
 
 void WriteFailure(const RunJob& run, const std::string& stage, const std::string& message) {
-  std::filesystem::create_directories(run.run_folder);
+  CreateFolder(run.run_folder);
   WriteTextFile(run.run_folder / "failure.json", Json{{"stage", stage}, {"error", message}}.dump(2) + '\n');
 }
 
@@ -479,7 +480,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   for (size_t i = 0; i < plan.prepares.size(); ++i) {
     const PrepareJob& prepare = plan.prepares[i];
     if (std::filesystem::exists(prepare.folder)) continue;
-    std::filesystem::create_directories(prepare.folder.parent_path());
+    CreateFolder(prepare.folder.parent_path());
     const std::filesystem::path partial = PartialFolder(prepare.folder);
     Command command{PrepareCommand(prepare, programs), partial.string() + ".log"};
     command.argv.insert(command.argv.end(), {"--out", partial.string()});
@@ -530,7 +531,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
       WriteFailure(run, "prepare", prepare_errors[run.prepare]);
       continue;
     }
-    std::filesystem::create_directories(run.run_folder.parent_path());
+    CreateFolder(run.run_folder.parent_path());
     Command command{{ProgramOf(run, programs).string()}, run.run_folder.string() + ".log", run_timeout_seconds};
     command.argv.insert(command.argv.end(), run.arguments.begin(), run.arguments.end());
     runs.push_back(command);

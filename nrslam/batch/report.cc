@@ -17,6 +17,7 @@
 #include "nrslam/eval/trajectory_error.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
@@ -334,7 +335,7 @@ std::string SeedSection(const std::vector<SeedGroup>& groups) {
 
 void WriteReport(const std::vector<RunResult>& results, const std::vector<RigidComparison>& comparisons,
                  const std::vector<SeedGroup>& seed_groups, const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
+  CreateFolder(folder);
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>nrslam evaluation</title>\n"
           "<style>body{font-family:sans-serif;margin:24px;max-width:1200px}table{border-collapse:collapse}"

@@ -10,6 +10,7 @@
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/csv.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/student_t.h"
@@ -464,7 +465,7 @@ void PrintResults(const std::vector<RunResult>& results, std::ostream& out) {
 }
 
 void WriteResults(const std::vector<RunResult>& results, const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
+  CreateFolder(folder);
   WriteTextFile(folder / "results.json", ToJson(results).dump(2) + '\n');
   WriteResultTables(results, folder);
   std::ostringstream csv;

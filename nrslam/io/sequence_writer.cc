@@ -4,6 +4,7 @@
 
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/text_file.h"
 
@@ -34,11 +35,9 @@ SequenceWriter::SequenceWriter(const fs::path& folder, const SequenceInfo& info,
   if (target == Target::kNewSequence && fs::exists(folder / "sequence.json")) {
     throw Error(folder.string() + " already holds a sequence (sequence.json); remove it or write to another folder");
   }
-  std::error_code error;
-  fs::create_directories(folder / "rgb", error);
-  if (with_depth) fs::create_directories(folder / "depth", error);
-  if (info.stereo) fs::create_directories(folder / "right", error);
-  if (error) throw Error("cannot create " + folder.string() + ": " + error.message());
+  CreateFolder(folder / "rgb");
+  if (with_depth) CreateFolder(folder / "depth");
+  if (info.stereo) CreateFolder(folder / "right");
   WriteTextFile(folder / "sequence.json", nlohmann::json(info_).dump(2) + '\n');
 }
 

@@ -7,6 +7,7 @@
 
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/median.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_file.h"
@@ -227,6 +228,7 @@ void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& fram
 
 RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::filesystem::path& sequence,
                                 const nlohmann::json& config) {
+  CreateFolder(out);
   std::error_code error;
   // An earlier run's output in the same folder goes first, its summary before anything else: a
   // run that stops early must not leave the last run's result beside its own configuration,
@@ -235,8 +237,7 @@ RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::fil
     std::filesystem::remove_all(out / file, error);
     if (error) throw Error("cannot remove the earlier run's " + (out / file).string() + ": " + error.message());
   }
-  std::filesystem::create_directories(out / "depth", error);
-  if (error) throw Error("cannot create " + out.string() + ": " + error.message());
+  CreateFolder(out / "depth");
   {
     nlohmann::json written{{"nrslam_version", NRSLAM_VERSION},
                            {"nrslam_revision", SourceRevision()},

@@ -8,12 +8,13 @@
 #include <cstring>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/folder.h"
 #include "nrslam/util/text_file.h"
 
 namespace nrslam {
 
 FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& holder) {
-  std::filesystem::create_directories(folder);
+  CreateFolder(folder);
   const std::filesystem::path path = folder / ".lock";
   // Not close-on-exec: child processes share the lock, so that runs an evaluation started hold
   // the folder until they end even when the evaluation itself was killed.
