@@ -17,8 +17,10 @@
 #include <sstream>
 #include <thread>
 
+#include "nrslam/batch/baseline.h"
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/manifest.h"
+#include "nrslam/batch/paired_comparison.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 #include "nrslam/batch/results_diff.h"

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "documentation_footer.h"
+#include "nrslam/batch/baseline.h"
 #include "nrslam/batch/evaluation_plan.h"
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"

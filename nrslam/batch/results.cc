@@ -1,7 +1,6 @@
 #include "nrslam/batch/results.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -13,7 +12,6 @@
 #include "nrslam/util/folder.h"
 #include "nrslam/util/json_options.h"
 #include "nrslam/util/median.h"
-#include "nrslam/util/student_t.h"
 #include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
 
@@ -89,9 +87,6 @@ std::string PairKey(const RunResult& run, const std::string& option, const std::
   return key;
 }
 
-// A ratio as the tables print it; `reciprocal` turns it the other way up.
-std::string RatioCell(double ratio, bool reciprocal) { return FormatFixed(reciprocal ? 1 / ratio : ratio, 3); }
-
 }  // namespace
 
 std::string DescribeRevisions(const std::vector<std::string>& revisions) {
@@ -121,102 +116,6 @@ std::string RunKey(const RunResult& result) {
   return RunName(result.sequence, result.label);
 }
 
-void RmseChangeCounts::Add(double reference_mm, double rmse_mm) {
-  const double change = rmse_mm - reference_mm;
-  const bool unchanged = std::abs(change) < 5e-4;
-  ++(unchanged ? same : change < 0 ? better : worse);
-  if (reference_mm > 0 && rmse_mm > 0) {
-    log_ratios.push_back(std::log(rmse_mm / reference_mm));
-    pair_moved.push_back(!unchanged);
-  }
-}
-
-double RmseChangeCounts::GeometricMeanRatio() const {
-  return log_ratios.empty() ? 1.0 : std::exp(Mean(log_ratios));
-}
-
-std::optional<RmseChangeCounts::RatioInterval> RmseChangeCounts::GeometricMeanRatioInterval(double confidence) const {
-  const size_t n = log_ratios.size();
-  if (n < 2) return std::nullopt;
-  const double mean = Mean(log_ratios);
-  double squares = 0;
-  for (double r : log_ratios) squares += (r - mean) * (r - mean);
-  const double standard_error = std::sqrt(squares / (n - 1) / n);
-  const double half_width = StudentTCriticalValue(confidence, static_cast<int>(n) - 1) * standard_error;
-  return RatioInterval{std::exp(mean - half_width), std::exp(mean + half_width)};
-}
-
-std::string RmseChangeCounts::GeometricMeanRatioIntervalText(bool reciprocal) const {
-  const auto interval = GeometricMeanRatioInterval();
-  if (!interval) return "";
-  // Turned the other way up, the interval's upper end becomes the lower.
-  const double first = reciprocal ? interval->high : interval->low, last = reciprocal ? interval->low : interval->high;
-  return RatioCell(first, reciprocal) + " to " + RatioCell(last, reciprocal);
-}
-
-std::string RmseChangeCounts::GeometricMeanRatioText(bool reciprocal) const {
-  const std::string interval = GeometricMeanRatioIntervalText(reciprocal);
-  return RatioCell(GeometricMeanRatio(), reciprocal) + (interval.empty() ? "" : " (95 % CI " + interval + ")");
-}
-
-double RmseChangeCounts::SignedRankP() const {
-  std::vector<double> changes;
-  for (size_t i = 0; i < log_ratios.size(); ++i) {
-    if (pair_moved[i]) changes.push_back(log_ratios[i]);
-  }
-  const int n = static_cast<int>(changes.size());
-  if (n == 0) return 1.0;
-  std::sort(changes.begin(), changes.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
-  // Ranks of |change|, ties sharing their mean rank; doubled so that every rank is an integer.
-  std::vector<int> doubled_rank(n);
-  double tie_term = 0;  // sum of t³ − t over the tie groups
-  for (int first = 0; first < n;) {
-    int last = first;
-    while (last + 1 < n && std::abs(changes[last + 1]) == std::abs(changes[first])) ++last;
-    for (int i = first; i <= last; ++i) doubled_rank[i] = first + last + 2;
-    const double t = last - first + 1;
-    tie_term += t * t * t - t;
-    first = last + 1;
-  }
-  int doubled_w_plus = 0;  // twice the rank sum of the runs that got worse
-  for (int i = 0; i < n; ++i) doubled_w_plus += changes[i] > 0 ? doubled_rank[i] : 0;
-  const int doubled_total = n * (n + 1);
-  if (n <= 200) {
-    // Distribution of the doubled rank sum when each run's sign is a fair coin.
-    std::vector<double> probability(doubled_total + 1, 0.0);
-    probability[0] = 1;
-    int reach = 0;
-    for (int r : doubled_rank) {
-      for (int s = reach; s >= 0; --s) {
-        probability[s + r] += 0.5 * probability[s];
-        probability[s] *= 0.5;
-      }
-      reach += r;
-    }
-    double lower = 0, upper = 0;
-    for (int s = 0; s <= doubled_total; ++s) (s <= doubled_w_plus ? lower : upper) += probability[s];
-    upper += probability[doubled_w_plus];  // P(W+ >= w) includes w itself
-    return std::min(1.0, 2 * std::min(lower, upper));
-  }
-  const double mean = n * (n + 1) / 4.0;
-  const double variance = n * (n + 1) * (2.0 * n + 1) / 24.0 - tie_term / 48.0;
-  const double distance = std::max(0.0, std::abs(doubled_w_plus / 2.0 - mean) - 0.5);  // continuity correction
-  return variance > 0 ? std::min(1.0, std::erfc(distance / std::sqrt(2 * variance))) : 1.0;
-}
-
-double RmseChangeCounts::SignTestP() const {
-  const int moved = better + worse, larger = std::max(better, worse);
-  // Binomial(moved, 1/2) tail from `larger` up, each term by log-gamma so that long sweeps
-  // cannot overflow.
-  const double log_all_splits = std::lgamma(moved + 1.0) - moved * std::log(2.0);
-  double tail = 0;
-  for (int k = larger; k <= moved; ++k) tail += std::exp(log_all_splits - std::lgamma(k + 1.0) - std::lgamma(moved - k + 1.0));
-  return moved == 0 ? 1.0 : std::min(1.0, 2 * tail);
-}
-
-std::string RmseChangeCounts::ToString() const {
-  return std::to_string(better) + " / " + std::to_string(same) + " / " + std::to_string(worse);
-}
 
 std::string RunStatus(const RunResult& figures) {
   if (figures.init_frame < 0) return "not_initialised";
@@ -574,131 +473,6 @@ std::vector<SweepValueSummary> SummariseSweep(const std::vector<RunResult>& resu
     }
   }
   return summaries;
-}
-
-Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance& tolerance) {
-  Json runs = Json::object();
-  for (const RunResult& r : results) {
-    if (r.status == "failed") continue;
-    runs[RunKey(r)] = {{"rmse_mm", r.rmse_mm}, {"frames_tracked", r.frames_tracked}};
-    if (!r.revision.empty()) runs[RunKey(r)]["revision"] = r.revision;
-    if (!r.code.empty()) runs[RunKey(r)]["code"] = r.code;
-  }
-  return {{"tolerance",
-           {{"rmse_relative", tolerance.rmse_relative},
-            {"rmse_absolute_mm", tolerance.rmse_absolute_mm},
-            {"frames_tracked", tolerance.frames_tracked},
-            {"pooled_rmse_relative", tolerance.pooled_rmse_relative}}},
-          {"runs", runs}};
-}
-
-namespace {
-
-// What a check reads of a baseline, or Error saying what is missing.
-BaselineTolerance ToleranceOf(const Json& baseline) {
-  BaselineTolerance tolerance;
-  try {
-    const Json& given = baseline.at("tolerance");
-    tolerance.rmse_relative = given.at("rmse_relative");
-    tolerance.rmse_absolute_mm = given.at("rmse_absolute_mm");
-    tolerance.frames_tracked = given.at("frames_tracked");
-    // Baselines written before the pooled check have none: they check run by run only.
-    tolerance.pooled_rmse_relative = given.value("pooled_rmse_relative", 0.0);
-    if (!(tolerance.pooled_rmse_relative >= 0)) throw Error("baseline: \"pooled_rmse_relative\" must be 0 or more");
-    if (!baseline.at("runs").is_object()) throw Error("baseline: \"runs\" must map run names to their figures");
-    for (const auto& [key, run] : baseline.at("runs").items()) {
-      if (!run.is_object() || !run.value("rmse_mm", Json()).is_number() ||
-          !run.value("frames_tracked", Json()).is_number()) {
-        throw Error("baseline: run '" + key + "' needs \"rmse_mm\" and \"frames_tracked\" numbers");
-      }
-    }
-  } catch (const Json::exception& e) {
-    throw Error(std::string("baseline is malformed (needs \"tolerance\" and \"runs\"): ") + e.what());
-  }
-  return tolerance;
-}
-
-}  // namespace
-
-Json ReadBaseline(const std::filesystem::path& file) {
-  const Json baseline = ReadJsonFile(file);
-  try {
-    ToleranceOf(baseline);
-  } catch (const Error& e) {
-    throw Error(file.string() + ": " + e.what());
-  }
-  return baseline;
-}
-
-BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline) {
-  const BaselineTolerance tolerance = ToleranceOf(baseline);
-  const Json& runs = baseline.at("runs");
-  std::map<std::string, const RunResult*> by_key;
-  for (const RunResult& r : results) by_key[RunKey(r)] = &r;
-  std::vector<std::string> baseline_revisions, baseline_codes, run_codes;
-  for (const RunResult& r : results) run_codes.push_back(r.code);
-  BaselineCheck check;
-  RmseChangeCounts pooled;  // over the runs with a figure on both sides
-  TextTable table({"run", "RMSE before", "RMSE now", "allowed", "tracked before", "tracked now", "verdict"});
-  for (const auto& [key, expected] : runs.items()) {
-    baseline_revisions.push_back(expected.value("revision", ""));
-    baseline_codes.push_back(expected.value("code", ""));
-    const double rmse_before = expected.at("rmse_mm");
-    const int tracked_before = expected.at("frames_tracked");
-    const double allowed = rmse_before * (1.0 + tolerance.rmse_relative) + tolerance.rmse_absolute_mm;
-    const auto found = by_key.find(key);
-    std::string verdict = "ok";
-    std::vector<std::string> row = {key, FormatFixed(rmse_before, 3)};
-    if (found == by_key.end() || found->second->status == "failed") {
-      verdict = found == by_key.end() ? "MISSING" : "FAILED: " + found->second->error;
-      row.insert(row.end(), {"-", FormatFixed(allowed, 3), std::to_string(tracked_before), "-"});
-    } else {
-      const RunResult& now = *found->second;
-      pooled.Add(rmse_before, now.rmse_mm);
-      if (now.frames_tracked < tracked_before - tolerance.frames_tracked) {
-        verdict = "WORSE: fewer frames tracked";
-      } else if (now.rmse_mm > allowed) {
-        verdict = "WORSE: RMSE +" + FormatFixed(100.0 * (now.rmse_mm / rmse_before - 1.0), 1) + " %";
-      } else if (now.rmse_mm < rmse_before * (1.0 - tolerance.rmse_relative) - tolerance.rmse_absolute_mm) {
-        verdict = "better (consider updating the baseline)";
-      }
-      row.insert(row.end(), {FormatFixed(now.rmse_mm, 3), FormatFixed(allowed, 3), std::to_string(tracked_before),
-                             std::to_string(now.frames_tracked)});
-    }
-    check.passed &= verdict.rfind("ok", 0) == 0 || verdict.rfind("better", 0) == 0;
-    row.push_back(verdict);
-    table.AddRow(row);
-  }
-  std::ostringstream report;
-  report << "Baseline check (RMSE may grow by " << FormatFixed(100 * tolerance.rmse_relative, 0) << " % + "
-         << tolerance.rmse_absolute_mm << " mm per run";
-  if (tolerance.pooled_rmse_relative > 0) {
-    report << " and by " << FormatFixed(100 * tolerance.pooled_rmse_relative, 0) << " % over all runs (geometric mean)";
-  }
-  report << "; frames tracked may drop by " << tolerance.frames_tracked << "):\n"
-         << "code of the baseline: " << DescribeRevisions(baseline_revisions) << "; of these runs: " << DescribeRevisions(results);
-  const std::string same_code = CompareCode(baseline_codes, run_codes);
-  report << (same_code.empty() ? "" : " (" + same_code + ")") << '\n';
-  table.Print(report);
-  const double ratio = pooled.GeometricMeanRatio();
-  const bool pooled_passed =
-      tolerance.pooled_rmse_relative == 0 || ratio <= 1.0 + tolerance.pooled_rmse_relative;
-  report << "All runs together (better / same / worse): " << pooled.ToString()
-         << "; RMSE ratio now / before, geometric mean: " << pooled.GeometricMeanRatioText();
-  if (tolerance.pooled_rmse_relative > 0) {
-    report << ", allowed " << FormatFixed(1.0 + tolerance.pooled_rmse_relative, 3) << (pooled_passed ? "" : ": WORSE");
-  }
-  report << "; signed-rank p = " << FormatFixed(pooled.SignedRankP(), 3) << '\n';
-  if (!check.passed) {
-    report << "FAILED: at least one run is worse than the baseline allows\n";
-  } else if (!pooled_passed) {
-    report << "FAILED: the runs together are worse than the baseline allows\n";
-  } else {
-    report << "PASSED\n";
-  }
-  check.passed &= pooled_passed;
-  check.report = report.str();
-  return check;
 }
 
 }  // namespace nrslam

@@ -1,5 +1,5 @@
 // batch: the results of an evaluation — one row per run, read back from the run folders —
-// as a table, results.json / results.csv, and the regression baseline check.
+// as a table and as results.json / results.csv, and per swept value.
 #pragma once
 
 #include <filesystem>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/paired_comparison.h"
 #include "nrslam/system/run_files.h"
 #include "nrslam/util/json_options.h"
 
@@ -60,41 +61,6 @@ std::string DescribeRevisions(const std::vector<RunResult>& results);
 // fingerprint (their commits may still differ, in documentation or tests), "other code" when
 // every run records one and they differ, "" when a run does not record one (older runs).
 std::string CompareCode(const std::vector<std::string>& codes_a, const std::vector<std::string>& codes_b);
-// Paired runs counted by how a run's RMSE compares with its partner's (the reference):
-// "same" when equal to the printed 0.001 mm.
-struct RmseChangeCounts {
-  int better = 0, same = 0, worse = 0;
-  // log(RMSE / reference) of each pair with both RMSEs positive, and whether that pair moved
-  // (was not "same"): the size of each change, which the counts leave out.
-  std::vector<double> log_ratios;
-  std::vector<bool> pair_moved;
-  void Add(double reference_mm, double rmse_mm);
-  std::string ToString() const;  // "better / same / worse"
-  // Two-sided exact sign test over the runs that moved (ties left out): the chance of a split
-  // at least this uneven if better and worse were equally likely. 1 when none moved.
-  double SignTestP() const;
-  // exp(mean log ratio): the factor by which the RMSE typically changed (0.9: 10 % lower),
-  // so that a 0.3 mm and a 15 mm sequence weigh alike. 1 with no pair.
-  double GeometricMeanRatio() const;
-  // The `confidence` interval of that factor, from Student's t over the log ratios: how far
-  // the typical change could be from the measured one, were the same runs drawn again from
-  // the scenes and seeds they stand for. Needs 2 pairs or more.
-  struct RatioInterval {
-    double low = 1, high = 1;
-  };
-  std::optional<RatioInterval> GeometricMeanRatioInterval(double confidence = 0.95) const;
-  // The 95 % interval as tables print it, "0.981 to 1.109", or "" when there is none;
-  // `reciprocal` turns it the other way up (reference / RMSE).
-  std::string GeometricMeanRatioIntervalText(bool reciprocal = false) const;
-  // The ratio with that interval, "1.043 (95 % CI 0.981 to 1.109)", or the ratio alone.
-  std::string GeometricMeanRatioText(bool reciprocal = false) const;
-  // Two-sided Wilcoxon signed-rank test of the log ratios of the runs that moved: like the
-  // sign test, but a run that changed much counts more than one that changed a little.
-  // Exact (the permutation distribution of the tied ranks) up to 200 runs, the normal
-  // approximation with tie correction above. 1 when none moved.
-  double SignedRankP() const;
-};
-
 // A finished run's status from its figures: "not_initialised", "lost" (it ends without tracking,
 // or left frames after its initialisation untracked) or "ok". Image dropouts skipped with the
 // map kept and unreadable frames do not make it "lost": they are the input's, which every run
@@ -165,32 +131,5 @@ std::vector<std::string> SweepSummaryCells(const SweepValueSummary& summary);
 // and where and why each run that ends without tracking stopped. With sweeps, also
 // SummariseSweep's table.
 void PrintResults(const std::vector<RunResult>& results, std::ostream& out);
-
-// A regression baseline: per run key (sequence [label]), RMSE and frames tracked, plus the
-// tolerance a later result is allowed.
-struct BaselineTolerance {
-  double rmse_relative = 0.10;    // RMSE may grow by this fraction ...
-  double rmse_absolute_mm = 0.02; // ... plus this much (noise floor on near-zero RMSE)
-  int frames_tracked = 0;         // frames tracked may drop by this many
-  // All runs together: the geometric mean of their RMSE ratios (now ÷ before) may exceed 1 by
-  // this fraction; 0 = no such check. Why: monocular runs are chaotic (one run can move by a
-  // third when nothing is wrong), so a per-run tolerance that lets that through misses a change
-  // that makes every run 15 % worse; over a few dozen runs the chaos averages out.
-  double pooled_rmse_relative = 0;
-};
-Json MakeBaseline(const std::vector<RunResult>& results, const BaselineTolerance& tolerance);
-
-struct BaselineCheck {
-  bool passed = true;
-  std::string report;  // a table of every baselined run: before, now, verdict
-};
-// Fails on a run that is worse than tolerated, failed, or missing from the results, or on
-// runs worse together than the pooled tolerance allows (the report always gives that ratio,
-// with the better / same / worse counts and the signed-rank test, as `nrslam_eval diff`). Throws
-// Error when `baseline` lacks what a check needs (a tolerance, and per run its RMSE and frames).
-BaselineCheck CheckBaseline(const std::vector<RunResult>& results, const Json& baseline);
-// A baseline file, read and checked as CheckBaseline needs it: nrslam_eval reads it before any
-// run, so a wrong path or a damaged file fails at once and not after the evaluation.
-Json ReadBaseline(const std::filesystem::path& file);
 
 }  // namespace nrslam

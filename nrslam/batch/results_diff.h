@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "nrslam/batch/paired_comparison.h"
 #include "nrslam/batch/results.h"
 
 namespace nrslam {

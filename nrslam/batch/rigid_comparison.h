@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/paired_comparison.h"
 #include "nrslam/batch/results.h"
 #include "nrslam/eval/common_points.h"
 
