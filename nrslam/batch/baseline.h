@@ -1,6 +1,6 @@
 // batch: the regression baseline: a results file's RMSE and frames per run with the tolerance
 // a later evaluation is allowed, and the check of an evaluation against it (nrslam_eval
-// --write-baseline / --baseline).
+// --write-baseline / --check-baseline).
 #pragma once
 
 #include <filesystem>
