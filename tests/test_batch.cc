@@ -36,6 +36,7 @@
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
+#include "error_message.h"
 #include "shell_command.h"
 #include "temp_folder.h"
 
@@ -62,12 +63,7 @@ std::filesystem::path WriteFile(const std::filesystem::path& file, const std::st
 }
 
 std::string ErrorOf(const std::filesystem::path& manifest) {
-  try {
-    LoadManifest(manifest);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return ErrorMessage([&] { LoadManifest(manifest); });
 }
 
 // A tiny simulated sequence: enough frames and points to track, quick to render and run.

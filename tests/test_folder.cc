@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "nrslam/util/error.h"
+#include "error_message.h"
 #include "nrslam/util/folder.h"
 #include "nrslam/util/text_file.h"
 #include "temp_folder.h"
@@ -14,12 +14,7 @@ namespace nrslam {
 namespace {
 
 std::string CreateFolderError(const std::filesystem::path& folder) {
-  try {
-    CreateFolder(folder);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return ErrorMessage([&] { CreateFolder(folder); });
 }
 
 TEST(Folder, CreatesItsParentsAndAcceptsOneThatExists) {

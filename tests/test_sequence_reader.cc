@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 
+#include "error_message.h"
 #include "temp_folder.h"
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/io/sequence_reader.h"
@@ -38,12 +39,7 @@ class SequenceReaderTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(folder_); }
 
   std::string ErrorOf() {
-    try {
-      SequenceReader reader(folder_);
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "";
+    return ErrorMessage([&] { SequenceReader reader(folder_); });
   }
   void RewriteJson(const std::function<void(nlohmann::json&)>& edit) {
     nlohmann::json json = info_;
