@@ -156,6 +156,23 @@ TEST_F(SequenceReaderTest, GroundtruthLineCount) {
   EXPECT_ERROR_MENTIONS("groundtruth.tum has 1 poses, expected 40");
 }
 
+// Poses are matched to frames by their order and trajectories are written at t = index / fps,
+// so poses out of order or on another clock would be scored against the wrong frames.
+TEST_F(SequenceReaderTest, GroundtruthOffTheFrameClockIsNamed) {
+  const auto write_times = [&](const std::function<double(int)>& time_of_frame) {
+    std::vector<StampedPose> poses;
+    for (int i = 0; i < kFrames; ++i) poses.push_back({time_of_frame(i), Rigid3()});
+    WriteTum(folder_ / "groundtruth.tum", poses);
+  };
+  const double period = 1.0 / info_.fps;
+  write_times([&](int i) { return (i == 5 ? 6 : i == 6 ? 5 : i) * period; });
+  EXPECT_ERROR_MENTIONS("groundtruth.tum: pose 6 has t = 0.2 s, but frame 5 is at 5 / 30 fps = 0.166667 s");
+  write_times([&](int i) { return 1305031102.175 + i * period; });
+  EXPECT_ERROR_MENTIONS("groundtruth.tum: pose 1 has t = 1.30503e+09 s, but frame 0 is at 0 / 30 fps = 0 s");
+  write_times([&](int i) { return (i + (i % 2 ? 0.4 : -0.4)) * period; });
+  EXPECT_TRUE(SequenceReader(folder_).has_groundtruth());
+}
+
 // A folder where a file should be opens as a stream on Linux: named as a folder, not read as an
 // empty file (no poses) or failed with the C library's "Is a directory" and no file name.
 TEST_F(SequenceReaderTest, AFolderInPlaceOfAFileIsNamed) {

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <sstream>
 
 #include "nrslam/io/depth_encoding.h"
@@ -36,6 +37,23 @@ struct ImageRequirement {
 std::string Describe(const PngHeader& header) {
   return std::to_string(header.bit_depth) + "-bit " + std::to_string(header.channels) + "-channel " +
          std::to_string(header.width) + "x" + std::to_string(header.height);
+}
+
+// The poses are matched to frames by their order, and written trajectories carry
+// t = index / fps, so a pose off that clock (lines out of order, or another time base) would
+// be scored against the wrong frame, or in evo against none.
+std::string GroundtruthTimeProblem(const std::vector<StampedPose>& poses, double fps) {
+  for (size_t index = 0; index < poses.size(); ++index) {
+    const double expected = static_cast<double>(index) / fps;
+    if (std::abs(poses[index].timestamp - expected) > 0.5 / fps) {
+      std::ostringstream text;
+      text << "groundtruth.tum: pose " << index + 1 << " has t = " << poses[index].timestamp << " s, but frame "
+           << index << " is at " << index << " / " << fps << " fps = " << expected
+           << " s (one pose per frame, in frame order, t = index / fps)";
+      return text.str();
+    }
+  }
+  return "";
 }
 
 void CheckFrames(const fs::path& folder, const ImageRequirement& requirement, const SequenceInfo& info,
@@ -121,6 +139,9 @@ SequenceReader::SequenceReader(const fs::path& folder) : folder_(folder) {
       if (static_cast<int>(groundtruth_.size()) != info_.frame_count) {
         problems.push_back("groundtruth.tum has " + std::to_string(groundtruth_.size()) + " poses, expected " +
                            std::to_string(info_.frame_count) + " (one per frame)");
+        groundtruth_.clear();
+      } else if (const std::string problem = GroundtruthTimeProblem(groundtruth_, info_.fps); !problem.empty()) {
+        problems.push_back(problem);
         groundtruth_.clear();
       }
     } catch (const Error& e) {
