@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include "error_message.h"
 #include "nrslam/mapping/mapping_options.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/system/system_options.h"
@@ -95,6 +96,26 @@ TEST(JsonOptions, ValuesOfTheWrongKindAreNamed) {
     EXPECT_EQ(what.find("fov_deg"), std::string::npos) << what;  // a whole number is a number
   }
   EXPECT_DOUBLE_EQ(OptionsFromJson<SimOptions>(Json{{"camera", {{"fov_deg", 80}}}}, "test").camera.fov_deg, 80.0);
+}
+
+// Fields of files a person writes (sequence.json, a camera) are read by kind, never truncated.
+TEST(JsonFields, ValuesOfAnotherKindAreNamedNotConverted) {
+  const Json given = {{"width", 320},    {"fps", 30},           {"half", 320.5},
+                      {"text", "abc"},   {"huge", 10000000000}, {"mixed", {1.5, "a"}},
+                      {"list", {1, 2.5}}};
+  EXPECT_EQ(Field<int>(given, "width", "camera"), 320);
+  EXPECT_DOUBLE_EQ(Field<double>(given, "fps", "camera"), 30.0);  // a whole number is a number
+  EXPECT_EQ(Field<std::vector<double>>(given, "list", "camera"), (std::vector<double>{1.0, 2.5}));
+  EXPECT_EQ(Field(given, "absent", "camera", 7), 7);
+  EXPECT_EQ(ErrorMessage([&] { Field<int>(given, "half", "camera"); }), "camera: half must be a whole number, got 320.5");
+  EXPECT_EQ(ErrorMessage([&] { Field<int>(given, "huge", "camera"); }),
+            "camera: huge must be a whole number, got 10000000000");
+  EXPECT_EQ(ErrorMessage([&] { Field<double>(given, "text", "camera"); }), "camera: text must be a number, got \"abc\"");
+  EXPECT_EQ(ErrorMessage([&] { Field<std::string>(given, "fps", "camera"); }), "camera: fps must be a string, got 30");
+  EXPECT_EQ(ErrorMessage([&] { Field<std::vector<double>>(given, "mixed", "camera"); }),
+            "camera: mixed must be a list of numbers, got [1.5,\"a\"]");
+  EXPECT_EQ(ErrorMessage([&] { Field<double>(given, "absent", "camera"); }), "camera: missing field 'absent'");
+  EXPECT_EQ(ErrorMessage([&] { Field(given, "text", "camera", 1.0); }), "camera: text must be a number, got \"abc\"");
 }
 
 TEST(JsonOptions, RoundTripKeepsEveryField) {

@@ -145,6 +145,29 @@ TEST_F(SequenceReaderTest, MissingField) {
   EXPECT_ERROR_MENTIONS("missing field 'fps'");
 }
 
+TEST_F(SequenceReaderTest, FieldsOfAnotherKindAreNamedNotTruncated) {
+  RewriteJson([](nlohmann::json& j) { j["frame_count"] = 39.5; });
+  EXPECT_ERROR_MENTIONS("sequence.json: frame_count must be a whole number, got 39.5");
+  RewriteJson([](nlohmann::json& j) { j["camera"]["width"] = 40.5; });
+  EXPECT_ERROR_MENTIONS("camera: width must be a whole number, got 40.5");
+  RewriteJson([](nlohmann::json& j) { j["fps"] = "30"; });
+  EXPECT_ERROR_MENTIONS("sequence.json: fps must be a number, got \"30\"");
+  RewriteJson([](nlohmann::json& j) { j["stereo"] = {{"baseline_mm", "5"}}; });
+  EXPECT_ERROR_MENTIONS("sequence.json: stereo: baseline_mm must be a number, got \"5\"");
+}
+
+TEST_F(SequenceReaderTest, AnotherFormatOrALaterVersionIsRefused) {
+  RewriteJson([](nlohmann::json& j) { j["format"] = "tum-rgbd"; });
+  EXPECT_ERROR_MENTIONS("sequence.json: format is 'tum-rgbd', not 'nrslam-sequence'");
+  RewriteJson([](nlohmann::json& j) { j["version"] = 2; });
+  EXPECT_ERROR_MENTIONS("sequence.json: version 2 is newer than this nrslam reads (1)");
+  RewriteJson([](nlohmann::json& j) {
+    j.erase("format");
+    j.erase("version");
+  });
+  EXPECT_TRUE(SequenceReader(folder_).has_groundtruth());  // a hand-written file may leave both out
+}
+
 TEST_F(SequenceReaderTest, MissingFolderAndJson) {
   fs::remove(folder_ / "sequence.json");
   EXPECT_ERROR_MENTIONS("missing sequence.json");

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace nrslam {
 
@@ -420,46 +421,33 @@ void to_json(nlohmann::json& j, const Camera& camera) {
 
 void from_json(const nlohmann::json& j, Camera& camera) {
   if (!j.is_object()) throw Error("camera: expected a JSON object");
-  const auto require = [&](std::initializer_list<const char*> keys) {
-    for (const char* key : keys) {
-      if (!j.contains(key)) throw Error(std::string("camera: missing field '") + key + "'");
+  const auto number = [&](const char* key) { return Field<double>(j, key, "camera"); };
+  const auto numbers = [&](const char* key) { return Field<std::vector<double>>(j, key, "camera"); };
+  const std::string model = Field<std::string>(j, "model", "camera");
+  const int width = Field<int>(j, "width", "camera");
+  const int height = Field<int>(j, "height", "camera");
+  const double cx = number("cx"), cy = number("cy");
+  if (model == OcamModel::kName) {
+    // No affine part given: the identity, as OCamCalib starts from; no inverse polynomial: fitted to ss.
+    camera = Camera::Ocam(width, height, cx, cy, Field(j, "c", "camera", 1.0), Field(j, "d", "camera", 0.0),
+                          Field(j, "e", "camera", 0.0), numbers("ss"),
+                          Field(j, "invpol", "camera", std::vector<double>()));
+  } else if (model == PinholeModel::kName) {
+    camera = Camera::Pinhole(width, height, number("fx"), number("fy"), cx, cy);
+  } else if (model == KannalaBrandtModel::kName) {
+    if (!j.contains("k") || !j.at("k").is_array() || j.at("k").size() != 4) {
+      throw Error("camera: kannala_brandt needs 'k' with 4 coefficients");
     }
-  };
-  require({"model", "width", "height", "cx", "cy"});
-  try {
-    const std::string model = j.at("model").get<std::string>();
-    const int width = j.at("width").get<int>();
-    const int height = j.at("height").get<int>();
-    const double cx = j.at("cx").get<double>(), cy = j.at("cy").get<double>();
-    if (model == OcamModel::kName) {
-      require({"ss"});
-      // No affine part given: the identity, as OCamCalib starts from.
-      camera = Camera::Ocam(width, height, cx, cy, j.value("c", 1.0), j.value("d", 0.0), j.value("e", 0.0),
-                            j.at("ss").get<std::vector<double>>(),
-                            j.value("invpol", std::vector<double>()));  // none: fitted to ss
-      camera.Check();
-      return;
+    const std::vector<double> k = numbers("k");
+    camera = Camera::KannalaBrandt(width, height, number("fx"), number("fy"), cx, cy,
+                                   Eigen::Vector4d(k[0], k[1], k[2], k[3]));
+  } else if (model == OpenCvModel::kName) {
+    if (!j.contains("distortion") || !j.at("distortion").is_array()) {
+      throw Error("camera: opencv needs 'distortion': OpenCV's distCoeffs, k1 k2 p1 p2 [k3 [k4 k5 k6]]");
     }
-    require({"fx", "fy"});
-    const double fx = j.at("fx").get<double>(), fy = j.at("fy").get<double>();
-    if (model == PinholeModel::kName) {
-      camera = Camera::Pinhole(width, height, fx, fy, cx, cy);
-    } else if (model == KannalaBrandtModel::kName) {
-      if (!j.contains("k") || !j.at("k").is_array() || j.at("k").size() != 4) {
-        throw Error("camera: kannala_brandt needs 'k' with 4 coefficients");
-      }
-      const auto k = j.at("k").get<std::vector<double>>();
-      camera = Camera::KannalaBrandt(width, height, fx, fy, cx, cy, Eigen::Vector4d(k[0], k[1], k[2], k[3]));
-    } else if (model == OpenCvModel::kName) {
-      if (!j.contains("distortion") || !j.at("distortion").is_array()) {
-        throw Error("camera: opencv needs 'distortion': OpenCV's distCoeffs, k1 k2 p1 p2 [k3 [k4 k5 k6]]");
-      }
-      camera = Camera::OpenCv(width, height, fx, fy, cx, cy, j.at("distortion").get<std::vector<double>>());
-    } else {
-      throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt, opencv, ocam)");
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(std::string("camera: malformed field: ") + e.what());
+    camera = Camera::OpenCv(width, height, number("fx"), number("fy"), cx, cy, numbers("distortion"));
+  } else {
+    throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt, opencv, ocam)");
   }
   camera.Check();
 }

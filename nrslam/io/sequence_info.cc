@@ -4,8 +4,17 @@
 #include <cstdio>
 
 #include "nrslam/util/error.h"
+#include "nrslam/util/json_options.h"
 
 namespace nrslam {
+namespace {
+
+// What sequence.json's "format" and "version" say: a later version may mean fields this code
+// would misread, so it is refused rather than run.
+constexpr const char* kSequenceFormat = "nrslam-sequence";
+constexpr int kSequenceVersion = 1;
+
+}  // namespace
 
 void SequenceInfo::Check() const {
   camera.Check();
@@ -23,8 +32,8 @@ void SequenceInfo::Check() const {
 }
 
 void to_json(nlohmann::json& j, const SequenceInfo& info) {
-  j = nlohmann::json{{"format", "nrslam-sequence"},
-                     {"version", 1},
+  j = nlohmann::json{{"format", kSequenceFormat},
+                     {"version", kSequenceVersion},
                      {"camera", info.camera},
                      {"fps", info.fps},
                      {"frame_count", info.frame_count},
@@ -38,26 +47,30 @@ void to_json(nlohmann::json& j, const SequenceInfo& info) {
 
 void from_json(const nlohmann::json& j, SequenceInfo& info) {
   if (!j.is_object()) throw Error("sequence.json: expected a JSON object");
-  for (const char* key : {"camera", "fps", "frame_count"}) {
-    if (!j.contains(key)) throw Error(std::string("sequence.json: missing field '") + key + "'");
+  const std::string format = Field(j, "format", "sequence.json", std::string(kSequenceFormat));
+  if (format != kSequenceFormat) {
+    throw Error("sequence.json: format is '" + format + "', not '" + kSequenceFormat + "' (docs/data.md)");
   }
-  try {
-    info.camera = j.at("camera").get<Camera>();
-    info.fps = j.at("fps").get<double>();
-    info.frame_count = j.at("frame_count").get<int>();
-    info.depth_unit_mm = j.value("depth_unit_mm", 0.01);
-    info.mask = j.value("mask", std::string());
-    info.provenance = j.value("provenance", nlohmann::json::object());
-    info.stereo.reset();
-    if (j.contains("stereo")) {
-      const auto& stereo = j.at("stereo");
-      StereoInfo stereo_info;
-      stereo_info.baseline_mm = stereo.at("baseline_mm").get<double>();
-      stereo_info.right_camera = stereo.contains("right_camera") ? stereo.at("right_camera").get<Camera>() : info.camera;
-      info.stereo = stereo_info;
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(std::string("sequence.json: malformed field: ") + e.what());
+  const int version = Field(j, "version", "sequence.json", kSequenceVersion);
+  if (version > kSequenceVersion) {
+    throw Error("sequence.json: version " + std::to_string(version) + " is newer than this nrslam reads (" +
+                std::to_string(kSequenceVersion) + ")");
+  }
+  if (!j.contains("camera")) throw Error("sequence.json: missing field 'camera'");
+  info.camera = j.at("camera").get<Camera>();
+  info.fps = Field<double>(j, "fps", "sequence.json");
+  info.frame_count = Field<int>(j, "frame_count", "sequence.json");
+  info.depth_unit_mm = Field(j, "depth_unit_mm", "sequence.json", 0.01);
+  info.mask = Field(j, "mask", "sequence.json", std::string());
+  info.provenance = j.value("provenance", nlohmann::json::object());
+  info.stereo.reset();
+  if (j.contains("stereo")) {
+    const nlohmann::json& stereo = j.at("stereo");
+    if (!stereo.is_object()) throw Error("sequence.json: stereo must be a group, got " + stereo.dump());
+    StereoInfo stereo_info;
+    stereo_info.baseline_mm = Field<double>(stereo, "baseline_mm", "sequence.json: stereo");
+    stereo_info.right_camera = stereo.contains("right_camera") ? stereo.at("right_camera").get<Camera>() : info.camera;
+    info.stereo = stereo_info;
   }
   info.Check();
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "nrslam/util/text_file.h"
@@ -127,6 +128,31 @@ Json ParseLike(const Json& existing, const std::string& text, const std::string&
 }
 
 }  // namespace
+
+template <typename T>
+T Field(const Json& object, const std::string& key, const std::string& context) {
+  const auto found = object.find(key);
+  if (found == object.end()) throw Error(context + ": missing field '" + key + "'");
+  const Json& value = *found;
+  const Json reference = T{};
+  bool fits = Fits(value, reference);
+  std::string kind = KindOf(reference);
+  if constexpr (std::is_same_v<T, int>) {
+    fits = fits && (value.is_number_unsigned() ? value.get<unsigned long long>() <= std::numeric_limits<int>::max()
+                                               : value.get<long long>() >= std::numeric_limits<int>::min() &&
+                                                     value.get<long long>() <= std::numeric_limits<int>::max());
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    kind += " of numbers";
+    fits = fits && std::all_of(value.begin(), value.end(), [](const Json& element) { return element.is_number(); });
+  }
+  if (!fits) throw Error(context + ": " + key + " must be " + kind + ", got " + value.dump());
+  return value.get<T>();
+}
+
+template int Field<int>(const Json&, const std::string&, const std::string&);
+template double Field<double>(const Json&, const std::string&, const std::string&);
+template std::string Field<std::string>(const Json&, const std::string&, const std::string&);
+template std::vector<double> Field<std::vector<double>>(const Json&, const std::string&, const std::string&);
 
 std::string Assignment(const std::string& path, const Json& value) {
   return path + "=" + (value.is_string() ? value.get<std::string>() : value.dump());

@@ -60,6 +60,18 @@ std::optional<std::string> FindOptionName(const std::string& name, const std::ve
 // The same, throwing Error "<kind> 'name' is unknown; <hint>" or "... is ambiguous: a, b".
 std::string ResolveOptionName(const std::string& name, const std::vector<std::string>& paths, const std::string& kind);
 
+// `object[key]` as T (int, double, std::string or std::vector<double>), for files a person may
+// have written, such as sequence.json: a value of another kind is an Error "<context>: key
+// must be a whole number, got 320.5" rather than a truncated number or nlohmann's
+// "type_error.302" with no field named; a missing key is "<context>: missing field 'key'",
+// or gives `fallback` in the second form.
+template <typename T>
+T Field(const Json& object, const std::string& key, const std::string& context);
+template <typename T>
+T Field(const Json& object, const std::string& key, const std::string& context, const T& fallback) {
+  return object.contains(key) ? Field<T>(object, key, context) : fallback;
+}
+
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
 // rejecting unknown keys and values of the wrong kind, then Check()s.
 template <typename Options>
