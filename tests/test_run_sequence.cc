@@ -1565,6 +1565,16 @@ cv::Mat PaintDisplay(const fs::path& sequence, int frames = 40) {
   return strokes;
 }
 
+// Gives `sequence` another frame rate: sequence.json's, and its ground truth's clock with it.
+void SetFrameRate(const fs::path& sequence, double fps) {
+  nlohmann::json info = ReadJsonFile(sequence / "sequence.json");
+  info["fps"] = fps;
+  std::ofstream(sequence / "sequence.json") << info.dump(2);
+  std::vector<StampedPose> poses = ReadTum(sequence / "groundtruth.tum");
+  for (size_t index = 0; index < poses.size(); ++index) poses[index].timestamp = static_cast<double>(index) / fps;
+  WriteTum(sequence / "groundtruth.tum", poses);
+}
+
 // An endoscope's on-screen display (grey text, not bright enough to pass for a highlight) on
 // every frame: corners on it would be tracked as points that move with the camera. The run finds
 // it static from 24 of its frames and leaves it out; with that off, the display is tracked. (The
@@ -1638,9 +1648,7 @@ TEST_F(RunSequenceTest, AShortRunIsCheckedForADisplayOverItsWholeSequence) {
   const fs::path folder = CopyOfSequence("display_short_run");
   const fs::path sequence = folder / "sequence";
   const cv::Mat strokes = PaintDisplay(sequence);
-  nlohmann::json info = ReadJsonFile(sequence / "sequence.json");
-  info["fps"] = 10.0;
-  std::ofstream(sequence / "sequence.json") << info.dump(2);
+  SetFrameRate(sequence, 10.0);
   SystemOptions first_frames = TrackingExperiment();
   first_frames.run.last_frame = 12;
   const RunSummary run = RunSequence(sequence, first_frames, folder / "run");
@@ -1659,9 +1667,7 @@ TEST_F(RunSequenceTest, ADisplayShownForAWhileIsLeftOutOfItsFramesOnly) {
   const fs::path folder = CopyOfSequence("display_for_a_while");
   const fs::path sequence = folder / "sequence";
   const cv::Mat strokes = PaintDisplay(sequence, 20);
-  nlohmann::json info = ReadJsonFile(sequence / "sequence.json");
-  info["fps"] = 2.5;
-  std::ofstream(sequence / "sequence.json") << info.dump(2);
+  SetFrameRate(sequence, 2.5);
   const SequenceReader reader(sequence);
   const MaskOptions masks;
   EXPECT_EQ(StaticWindows(40, 2.5, masks), (std::vector<std::pair<int, int>>{{0, 20}, {10, 30}, {20, 40}}));
