@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "camera_fixtures.h"
+#include "error_message.h"
 #include "temp_folder.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/run_folder.h"
@@ -1214,6 +1215,10 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("no depth/"), std::string::npos) << e.what();
   }
+  SystemOptions past_the_end;
+  past_the_end.run.first_frame = 2;
+  EXPECT_EQ(ErrorMessage([&] { RunSequence(folder, past_the_end, folder / "run"); }),
+            "run.first_frame 2 is past the last frame of " + folder.string() + " (2 frames, 0 to 1)");
   // Monocular needs no depth: two frames are too few to initialise, a recorded outcome.
   const RunSummary monocular = RunSequence(folder, SystemOptions{}, folder / "run");
   EXPECT_EQ(monocular.init_frame, -1);

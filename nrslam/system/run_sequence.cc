@@ -152,7 +152,11 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   const Camera camera = options.run.camera.empty() ? reader.info().camera : CameraOverride(options.run.camera, reader);
   const int first = std::min(options.run.first_frame, reader.frame_count());
   const int last = options.run.last_frame < 0 ? reader.frame_count() : std::min(options.run.last_frame, reader.frame_count());
-  if (first >= last) throw Error("the frame range selects no frame of " + sequence.string());
+  if (first >= last) {
+    throw Error("run.first_frame " + std::to_string(options.run.first_frame) + " is past the last frame of " +
+                sequence.string() + " (" + std::to_string(reader.frame_count()) + " frames, 0 to " +
+                std::to_string(reader.frame_count() - 1) + ")");
+  }
 
   RunFolderStreams streams =
       BeginRunFolder(out, sequence, {{"sequence_info", reader.info()}, {"camera", camera}, {"options", options}});
