@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 #include "nrslam/util/text_file.h"
 #include "nrslam/util/text_table.h"
