@@ -28,7 +28,7 @@ constexpr int kWidth = 64, kHeight = 48, kFrames = 3;
 cv::Mat Frame(int index) {
   cv::Mat image(kHeight, kWidth, CV_8UC3);
   cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
-  image.row(0).setTo(cv::Scalar(index * 40, 0, 0));  // frames differ, and we can tell which is which
+  image.row(0).setTo(cv::Scalar(index * 20, 0, 0));  // frames differ, and we can tell which is which
   return image;
 }
 
@@ -92,7 +92,7 @@ TEST(DatasetImport, EndomapperSimulatedReversedZDepthAndInvertedPoses) {
   EXPECT_EQ(depth.at<float>(0, 0), 0.f);
   ASSERT_EQ(sequence.groundtruth().size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-3);
-  EXPECT_EQ(sequence.ReadRgb(2).at<cv::Vec3b>(0, 0)[0], 80);
+  EXPECT_EQ(sequence.ReadRgb(2).at<cv::Vec3b>(0, 0)[0], 40);
 
   fs::remove(in / "depth" / "aov_image_0002.exr");
   EXPECT_NE(ImportError(options, out).find("missing " + (in / "depth" / "aov_image_0002.exr").string()), std::string::npos);
@@ -205,16 +205,25 @@ TEST(DatasetImport, ScaleResizesImagesDepthAndCalibrationTogether) {
   fs::remove_all(out);
 }
 
-// C3VD poses come as one 4×4 per line; the importer must read both storage orders.
-void C3vdFixture(const fs::path& in, bool column_major) {
-  fs::create_directories(in);
+// The names C3VD gives its files: colour without leading zeros, depth with four, beside it.
+struct C3vdNames {
+  const char* colour = "%d_color.png";
+  const char* depth = "%04d_depth.tiff";
+};
+
+// C3VD poses come as one 4×4 per line; the importer must read both storage orders. Depth is
+// 20, 40, 60 … mm, up to the format's 100, with row 0 marking the frame (i + 1 units).
+void C3vdFixture(const fs::path& in, bool column_major, int frames = kFrames, const C3vdNames& names = {}) {
+  fs::create_directories((in / names.depth).parent_path());
   std::ofstream poses(in / "pose.txt");
-  for (int i = 0; i < kFrames; ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, "%04d_color.png", i);
+  for (int i = 0; i < frames; ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, names.colour, i);
     cv::imwrite((in / name).string(), Frame(i));
-    std::snprintf(name, sizeof name, "%04d_depth.tiff", i);
-    cv::imwrite((in / name).string(), cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(13107 * (i + 1))));  // 20, 40, 60 mm
+    std::snprintf(name, sizeof name, names.depth, i);
+    cv::Mat depth(kHeight, kWidth, CV_16UC1, cv::Scalar(13107 * std::min(i + 1, 5)));
+    depth.row(0).setTo(i + 1);
+    cv::imwrite((in / name).string(), depth);
     Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
     matrix.topLeftCorner<3, 3>() = Pose(i).rotation.toRotationMatrix();
     matrix.topRightCorner<3, 1>() = Pose(i).translation;
@@ -257,6 +266,46 @@ TEST(DatasetImport, C3vdDepthScaleAndBothPoseOrders) {
   }
 }
 
+// Past frame 9, C3VD's unpadded colour names sort by name as 0, 1, 10, 11, 2 …: the frames
+// are taken in the order of their numbers, and each depth found by its number, with four
+// leading zeros beside the colour or (the later release) in depth/, with none, or with six.
+TEST(DatasetImport, C3vdFramesInTheOrderOfTheirNumbersWhateverThePadding) {
+  for (const char* depth_names : {"%04d_depth.tiff", "depth/%04d_depth.tiff", "%d_depth.tiff", "%06d_depth.tiff"}) {
+    const fs::path in = UniqueTempFolder("c3vd_numbers_in"), out = UniqueTempFolder("c3vd_numbers_out");
+    constexpr int kManyFrames = 12;
+    C3vdFixture(in, false, kManyFrames, {"%d_color.png", depth_names});
+    WriteCalibration(in / "camera.json");
+    ImportOptions options = Options("c3vd", in);
+    options.calibration = in / "camera.json";
+    ImportDataset(options, out);
+    const SequenceReader sequence(out);
+    ASSERT_EQ(sequence.frame_count(), kManyFrames) << depth_names;
+    for (int i = 0; i < kManyFrames; ++i) {
+      EXPECT_EQ(sequence.ReadRgb(i).at<cv::Vec3b>(0, 5)[0], 20 * i) << depth_names << ", frame " << i;
+      EXPECT_NEAR(sequence.ReadDepthMm(i).at<float>(0, 5), (i + 1) * 100.0 / 65535.0, 0.01) << depth_names;
+      ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-4);
+    }
+    fs::remove_all(in);
+    fs::remove_all(out);
+  }
+  // pose.txt's lines are frames 0, 1, 2 …: a gap in the colour frames would pair the wrong poses.
+  const fs::path in = UniqueTempFolder("c3vd_gap_in");
+  C3vdFixture(in, false, 4);
+  fs::remove(in / "2_color.png");
+  ImportOptions options = Options("c3vd", in);
+  WriteCalibration(in / "camera.json");
+  options.calibration = in / "camera.json";
+  EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out"))
+                .find("3_color.png is where frame 2 should be: the colour images must be numbered 0, 1, 2"),
+            std::string::npos);
+  fs::remove(in / "3_color.png");
+  fs::remove(in / "0001_depth.tiff");
+  EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out"))
+                .find("no depth of frame 1 (1_depth.tiff, with leading zeros or none, here or in depth/)"),
+            std::string::npos);
+  fs::remove_all(in);
+}
+
 // C3VD's colonoscope is calibrated with OCamCalib: its calib_results.txt is the calibration as
 // it is (here a 64x48 fisheye written in that format).
 TEST(DatasetImport, C3vdWithItsOCamCalibResults) {
@@ -287,6 +336,24 @@ TEST(DatasetImport, C3vdWithItsOCamCalibResults) {
   EXPECT_LT((sequence.info().camera.Unproject(Eigen::Vector2d(50.3, 10.6)) - lens.Unproject(Eigen::Vector2d(50.3, 10.6)))
                 .norm(),
             1e-9);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+// Frames written as ffmpeg's frame_%d.png sort by name as 0, 1, 10, 11, 2 …; they are taken
+// in the order of their numbers.
+TEST(DatasetImport, ImageFolderNumberedWithoutLeadingZerosKeepsItsOrder) {
+  const fs::path in = UniqueTempFolder("numbered_in"), out = UniqueTempFolder("numbered_out");
+  fs::create_directories(in);
+  constexpr int kManyFrames = 12;
+  for (int i = 0; i < kManyFrames; ++i) cv::imwrite((in / ("frame_" + std::to_string(i) + ".png")).string(), Frame(i));
+  WriteCalibration(in / "camera.json");
+  ImportOptions options = Options("images", in);
+  options.calibration = in / "camera.json";
+  ImportDataset(options, out);
+  const SequenceReader sequence(out);
+  ASSERT_EQ(sequence.frame_count(), kManyFrames);
+  for (int i = 0; i < kManyFrames; ++i) EXPECT_EQ(sequence.ReadRgb(i).at<cv::Vec3b>(0, 5)[0], 20 * i) << "frame " << i;
   fs::remove_all(in);
   fs::remove_all(out);
 }

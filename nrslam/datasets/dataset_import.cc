@@ -6,14 +6,17 @@
 #include <opencv2/videoio/registry.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include "nrslam/datasets/stereo_depth.h"
 #include "nrslam/datasets/stereo_rectification.h"
@@ -63,7 +66,39 @@ cv::Mat ReadImage(const ImportOptions& options, const fs::path& file, int flags)
   return image;
 }
 
-// Image files of a folder, sorted by name.
+bool IsDigit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
+
+bool EndsWith(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// Name order that reads each run of digits as a number, so that "frame_2.png" comes before
+// "frame_10.png": folders numbered without leading zeros (ffmpeg's %d, C3VD's "12_color.png")
+// keep their frames' order. Names that differ only in leading zeros fall back to plain order.
+
+bool NumberAwareLess(const std::string& a, const std::string& b) {
+  size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (!IsDigit(a[i]) || !IsDigit(b[j])) {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i, ++j;
+      continue;
+    }
+    size_t end_a = i, end_b = j;
+    while (end_a < a.size() && IsDigit(a[end_a])) ++end_a;
+    while (end_b < b.size() && IsDigit(b[end_b])) ++end_b;
+    while (i + 1 < end_a && a[i] == '0') ++i;
+    while (j + 1 < end_b && b[j] == '0') ++j;
+    const std::string_view number_a(a.data() + i, end_a - i), number_b(b.data() + j, end_b - j);
+    if (number_a.size() != number_b.size()) return number_a.size() < number_b.size();
+    if (number_a != number_b) return number_a < number_b;
+    i = end_a, j = end_b;
+  }
+  if (i == a.size() && j == b.size()) return a < b;
+  return i == a.size();
+}
+
+// Image files of a folder, in NumberAwareLess order of their names.
 std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suffix = "") {
   std::vector<fs::path> files;
   if (!fs::is_directory(folder)) return files;
@@ -73,11 +108,23 @@ std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suff
     const bool image = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
                        extension == ".tif" || extension == ".tiff";
     const std::string stem = entry.path().stem().string();
-    const bool matches = suffix.empty() || (stem.size() > suffix.size() && stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0);
+    const bool matches = suffix.empty() || (stem.size() > suffix.size() && EndsWith(stem, suffix));
     if (entry.is_regular_file() && image && matches) files.push_back(entry.path());
   }
-  std::sort(files.begin(), files.end());
+  std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
+    return NumberAwareLess(a.filename().string(), b.filename().string());
+  });
   return files;
+}
+
+// The frame number N of a file named "N<suffix>.ext" (leading zeros or none); nothing for
+// another name.
+std::optional<int> FrameNumber(const fs::path& file, const std::string& suffix) {
+  const std::string stem = file.stem().string();
+  if (stem.size() <= suffix.size() || !EndsWith(stem, suffix)) return std::nullopt;
+  const std::string digits = stem.substr(0, stem.size() - suffix.size());
+  if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), IsDigit)) return std::nullopt;
+  return std::stoi(digits);
 }
 
 std::vector<double> Numbers(const std::string& line) {
@@ -214,13 +261,28 @@ FrameSource C3vd(const ImportOptions& options) {
   if (options.calibration.empty()) Fail(options, "needs --calibration (a camera JSON)");
   FrameSource source;
   const std::vector<fs::path> colour = ImageFiles(options.input, "_color");
-  if (colour.empty()) Fail(options, "no NNNN_color.png frames");
+  if (colour.empty()) Fail(options, "no N_color.png frames");
+  // C3VD writes colour without leading zeros ("12_color.png") and depth with four
+  // ("0012_depth.tiff"), in the sequence's folder or, in its later release, in depth/.
+  std::map<int, fs::path> depth_of_frame;
+  for (const fs::path& folder : {options.input, options.input / "depth"}) {
+    for (const fs::path& file : ImageFiles(folder, "_depth")) {
+      if (const std::optional<int> number = FrameNumber(file, "_depth")) depth_of_frame.emplace(*number, file);
+    }
+  }
   std::vector<fs::path> depth;
-  for (const fs::path& file : colour) {
-    const std::string stem = file.stem().string();
-    const fs::path depth_file = file.parent_path() / (stem.substr(0, stem.size() - 6) + "_depth.tiff");
-    if (!fs::exists(depth_file)) Fail(options, "missing " + depth_file.string());
-    depth.push_back(depth_file);
+  for (int frame = 0; frame < static_cast<int>(colour.size()); ++frame) {
+    // pose.txt has no frame numbers: its lines are frames 0, 1, 2 …, so the images must be too.
+    if (FrameNumber(colour[frame], "_color") != frame) {
+      Fail(options, colour[frame].filename().string() + " is where frame " + std::to_string(frame) +
+                        " should be: the colour images must be numbered 0, 1, 2 … as pose.txt's lines are");
+    }
+    const auto found = depth_of_frame.find(frame);
+    if (found == depth_of_frame.end()) {
+      Fail(options, "no depth of frame " + std::to_string(frame) + " (" + std::to_string(frame) +
+                        "_depth.tiff, with leading zeros or none, here or in depth/)");
+    }
+    depth.push_back(found->second);
   }
   source.count = static_cast<int>(colour.size());
   source.camera = LoadCalibration(options);
