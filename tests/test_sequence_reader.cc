@@ -279,6 +279,17 @@ TEST(DepthEncoding, RoundsToTheUnitAndKeepsNoneAsZero) {
   EXPECT_NEAR(decoded.at<float>(0, 5), 655.35f, 1e-3);
 }
 
+// Other programs' and datasets' file names give their frame by the last number in the stem.
+TEST(FrameNumberOf, TheLastRunOfDigitsWithOrWithoutLeadingZeros) {
+  EXPECT_EQ(FrameNumberOf("depth_000123"), 123);
+  EXPECT_EQ(FrameNumberOf("0123_depth"), 123);
+  EXPECT_EQ(FrameNumberOf("12_color"), 12);
+  EXPECT_EQ(FrameNumberOf("cam2_frame0045"), 45);
+  EXPECT_EQ(FrameNumberOf("0"), 0);
+  EXPECT_EQ(FrameNumberOf("depth"), std::nullopt);
+  EXPECT_EQ(FrameNumberOf("1234567890"), std::nullopt);  // past what a frame number can be
+}
+
 TEST_F(SequenceReaderTest, WrittenDepthReadsBackAsTheInMemoryRoundTrip) {
   cv::Mat depth_mm(30, 40, CV_32F);
   cv::randu(depth_mm, 1.0, 400.0);

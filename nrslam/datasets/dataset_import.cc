@@ -22,6 +22,7 @@
 #include "nrslam/datasets/stereo_rectification.h"
 #include "nrslam/geometry/rigid3.h"
 #include "nrslam/io/camera_file.h"
+#include "nrslam/io/sequence_info.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/text_file.h"
@@ -115,16 +116,6 @@ std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suff
     return NumberAwareLess(a.filename().string(), b.filename().string());
   });
   return files;
-}
-
-// The frame number N of a file named "N<suffix>.ext" (leading zeros or none); nothing for
-// another name.
-std::optional<int> FrameNumber(const fs::path& file, const std::string& suffix) {
-  const std::string stem = file.stem().string();
-  if (stem.size() <= suffix.size() || !EndsWith(stem, suffix)) return std::nullopt;
-  const std::string digits = stem.substr(0, stem.size() - suffix.size());
-  if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), IsDigit)) return std::nullopt;
-  return std::stoi(digits);
 }
 
 std::vector<double> Numbers(const std::string& line) {
@@ -267,13 +258,13 @@ FrameSource C3vd(const ImportOptions& options) {
   std::map<int, fs::path> depth_of_frame;
   for (const fs::path& folder : {options.input, options.input / "depth"}) {
     for (const fs::path& file : ImageFiles(folder, "_depth")) {
-      if (const std::optional<int> number = FrameNumber(file, "_depth")) depth_of_frame.emplace(*number, file);
+      if (const std::optional<int> number = FrameNumberOf(file.stem().string())) depth_of_frame.emplace(*number, file);
     }
   }
   std::vector<fs::path> depth;
   for (int frame = 0; frame < static_cast<int>(colour.size()); ++frame) {
     // pose.txt has no frame numbers: its lines are frames 0, 1, 2 …, so the images must be too.
-    if (FrameNumber(colour[frame], "_color") != frame) {
+    if (FrameNumberOf(colour[frame].stem().string()) != frame) {
       Fail(options, colour[frame].filename().string() + " is where frame " + std::to_string(frame) +
                         " should be: the colour images must be numbered 0, 1, 2 … as pose.txt's lines are");
     }

@@ -1,5 +1,6 @@
 #include "nrslam/io/sequence_info.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -73,6 +74,16 @@ void from_json(const nlohmann::json& j, SequenceInfo& info) {
     info.stereo = stereo_info;
   }
   info.Check();
+}
+
+std::optional<int> FrameNumberOf(const std::string& stem) {
+  const auto is_digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
+  size_t end = stem.size();
+  while (end > 0 && !is_digit(stem[end - 1])) --end;
+  size_t begin = end;
+  while (begin > 0 && is_digit(stem[begin - 1])) --begin;
+  if (begin == end || end - begin > 9) return std::nullopt;
+  return std::stoi(stem.substr(begin, end - begin));
 }
 
 std::string FrameFileName(int index) {

@@ -39,4 +39,9 @@ inline constexpr std::array<const char*, 5> kSequenceEntries = {"rgb", "depth", 
 // "000037.png": the file name of frame `index` in every per-frame folder.
 std::string FrameFileName(int index);
 
+// The frame number in another program's or dataset's file name: the last run of digits in
+// the stem, leading zeros or none ("depth_000123" and "0123_depth" → 123); nothing when the
+// stem has no digits or too many for a frame number.
+std::optional<int> FrameNumberOf(const std::string& stem);
+
 }  // namespace nrslam

@@ -99,16 +99,6 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
   return estimates;
 }
 
-// The last number in a file name ("depth_000123" → 123), if any.
-std::optional<int> FrameNumberOf(const std::string& stem) {
-  size_t end = stem.size();
-  while (end > 0 && !std::isdigit(static_cast<unsigned char>(stem[end - 1]))) --end;
-  size_t begin = end;
-  while (begin > 0 && std::isdigit(static_cast<unsigned char>(stem[begin - 1]))) --begin;
-  if (begin == end || end - begin > 9) return std::nullopt;
-  return std::stoi(stem.substr(begin, end - begin));
-}
-
 FrameEstimates ReadDepthImages(const fs::path& folder, const cv::Size& size, int stride, int frame_count) {
   // OpenCV 4.6 reads EXR only when asked to (CVE hardening), and depth networks write EXR.
   setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
