@@ -299,6 +299,9 @@ TEST(DatasetImport, C3vdFramesInTheOrderOfTheirNumbersWhateverThePadding) {
                 .find("3_color.png is where frame 2 should be: the colour images must be numbered 0, 1, 2"),
             std::string::npos);
   fs::remove(in / "3_color.png");
+  fs::copy_file(in / "0001_depth.tiff", in / "1_depth.tiff");
+  EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out")).find("two depth images of frame 1: "), std::string::npos);
+  fs::remove(in / "1_depth.tiff");
   fs::remove(in / "0001_depth.tiff");
   EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out"))
                 .find("no depth of frame 1 (1_depth.tiff, with leading zeros or none, here or in depth/)"),

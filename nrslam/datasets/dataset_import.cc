@@ -76,7 +76,6 @@ bool EndsWith(const std::string& text, const std::string& suffix) {
 // Name order that reads each run of digits as a number, so that "frame_2.png" comes before
 // "frame_10.png": folders numbered without leading zeros (ffmpeg's %d, C3VD's "12_color.png")
 // keep their frames' order. Names that differ only in leading zeros fall back to plain order.
-
 bool NumberAwareLess(const std::string& a, const std::string& b) {
   size_t i = 0, j = 0;
   while (i < a.size() && j < b.size()) {
@@ -258,7 +257,12 @@ FrameSource C3vd(const ImportOptions& options) {
   std::map<int, fs::path> depth_of_frame;
   for (const fs::path& folder : {options.input, options.input / "depth"}) {
     for (const fs::path& file : ImageFiles(folder, "_depth")) {
-      if (const std::optional<int> number = FrameNumberOf(file.stem().string())) depth_of_frame.emplace(*number, file);
+      const std::optional<int> number = FrameNumberOf(file.stem().string());
+      if (!number) continue;
+      if (const auto [kept, added] = depth_of_frame.emplace(*number, file); !added) {
+        Fail(options, "two depth images of frame " + std::to_string(*number) + ": " + kept->second.string() + " and " +
+                          file.string());
+      }
     }
   }
   std::vector<fs::path> depth;
