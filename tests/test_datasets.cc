@@ -212,7 +212,8 @@ struct C3vdNames {
 };
 
 // C3VD poses come as one 4×4 per line; the importer must read both storage orders. Depth is
-// 20, 40, 60 … mm, up to the format's 100, with row 0 marking the frame (i + 1 units).
+// 20, 40, 60 … mm, up to the format's 100, with row 0 marking the frame (1000 · (i + 1) units,
+// 1.5 mm apart).
 void C3vdFixture(const fs::path& in, bool column_major, int frames = kFrames, const C3vdNames& names = {}) {
   fs::create_directories((in / names.depth).parent_path());
   std::ofstream poses(in / "pose.txt");
@@ -222,7 +223,7 @@ void C3vdFixture(const fs::path& in, bool column_major, int frames = kFrames, co
     cv::imwrite((in / name).string(), Frame(i));
     std::snprintf(name, sizeof name, names.depth, i);
     cv::Mat depth(kHeight, kWidth, CV_16UC1, cv::Scalar(13107 * std::min(i + 1, 5)));
-    depth.row(0).setTo(i + 1);
+    depth.row(0).setTo(1000 * (i + 1));
     cv::imwrite((in / name).string(), depth);
     Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
     matrix.topLeftCorner<3, 3>() = Pose(i).rotation.toRotationMatrix();
@@ -282,7 +283,7 @@ TEST(DatasetImport, C3vdFramesInTheOrderOfTheirNumbersWhateverThePadding) {
     ASSERT_EQ(sequence.frame_count(), kManyFrames) << depth_names;
     for (int i = 0; i < kManyFrames; ++i) {
       EXPECT_EQ(sequence.ReadRgb(i).at<cv::Vec3b>(0, 5)[0], 20 * i) << depth_names << ", frame " << i;
-      EXPECT_NEAR(sequence.ReadDepthMm(i).at<float>(0, 5), (i + 1) * 100.0 / 65535.0, 0.01) << depth_names;
+      EXPECT_NEAR(sequence.ReadDepthMm(i).at<float>(0, 5), 1000.0 * (i + 1) * 100.0 / 65535.0, 0.01) << depth_names;
       ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-4);
     }
     fs::remove_all(in);

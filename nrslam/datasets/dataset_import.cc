@@ -69,10 +69,6 @@ cv::Mat ReadImage(const ImportOptions& options, const fs::path& file, int flags)
 
 bool IsDigit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
 
-bool EndsWith(const std::string& text, const std::string& suffix) {
-  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // Name order that reads each run of digits as a number, so that "frame_2.png" comes before
 // "frame_10.png": folders numbered without leading zeros (ffmpeg's %d, C3VD's "12_color.png")
 // keep their frames' order. Names that differ only in leading zeros fall back to plain order.
@@ -108,7 +104,7 @@ std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suff
     const bool image = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
                        extension == ".tif" || extension == ".tiff";
     const std::string stem = entry.path().stem().string();
-    const bool matches = suffix.empty() || (stem.size() > suffix.size() && EndsWith(stem, suffix));
+    const bool matches = suffix.empty() || (stem.size() > suffix.size() && stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0);
     if (entry.is_regular_file() && image && matches) files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
