@@ -144,12 +144,110 @@ TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
   options.stereo_depth = false;
 
   fs::remove(in / "image02" / "0000000001.png");
-  EXPECT_NE(ImportError(options, out).find("image02/ has 2 images, image01/ 3"), std::string::npos);
+  EXPECT_NE(ImportError(options, out).find("image02/ has no image of frame 1 (image01/0000000001.png)"),
+            std::string::npos);
   HamlynFixture(in, [](int i) { return cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)); });
   fs::remove(in / "intrinsics.txt");
   EXPECT_NE(ImportError(options, out).find("missing intrinsics.txt"), std::string::npos);
   fs::create_directory(in / "intrinsics.txt");  // opens as a stream, then reads as nothing
   EXPECT_NE(ImportError(options, out).find((in / "intrinsics.txt").string() + " is a folder, not a text file"),
+            std::string::npos);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+// intrinsics.txt is read by rows, so that K comes out right from a 3×3, a 3×4 projection matrix
+// or a homogeneous 4×4; a baseline line after it makes the right camera usable.
+TEST(DatasetImport, HamlynIntrinsicsAsThreeByThreeThreeByFourOrFourByFour) {
+  const fs::path in = UniqueTempFolder("hamlyn_k_in"), out = UniqueTempFolder("hamlyn_k_out");
+  HamlynFixture(in, [](int i) { return cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)); });
+  const ImportOptions options = Options("hamlyn", in);
+  const auto import_with = [&](const std::string& intrinsics) {
+    std::ofstream(in / "intrinsics.txt") << intrinsics;
+    fs::remove_all(out);
+    ImportDataset(options, out);
+    return SequenceReader(out);
+  };
+  const SequenceReader three_by_four = import_with("50.5 0 31.2 0\n0 50.7 23.9 0\n0 0 1 0\n5.38\n");
+  EXPECT_EQ(three_by_four.info().camera.params(), Camera::Pinhole(kWidth, kHeight, 50.5, 50.7, 31.2, 23.9).params());
+  ASSERT_TRUE(three_by_four.has_right());
+  EXPECT_DOUBLE_EQ(three_by_four.info().stereo->baseline_mm, 5.38);
+  const SequenceReader homogeneous = import_with("  50.5 0 31.2 0\r\n\n0 50.7 23.9 0\r\n0 0 1 0\r\n0 0 0 1\r\n");
+  EXPECT_EQ(homogeneous.info().camera.params(), Camera::Pinhole(kWidth, kHeight, 50.5, 50.7, 31.2, 23.9).params());
+  EXPECT_FALSE(homogeneous.has_right());  // no baseline: the right images cannot be used
+
+  const auto error_with = [&](const std::string& intrinsics) {
+    std::ofstream(in / "intrinsics.txt") << intrinsics;
+    return ImportError(options, out);
+  };
+  EXPECT_NE(error_with("50.5 0.2 31.2\n0 50.7 23.9\n0 0 1\n").find("is not a pinhole K"), std::string::npos);
+  EXPECT_NE(error_with("0 50.7 23.9\n50.5 0 31.2\n0 0 1\n").find("is not a pinhole K"), std::string::npos);
+  EXPECT_NE(error_with("50.5 0 31.2 50.7 23.9 0 0 1 5.38\n").find("expected K as three rows"), std::string::npos);
+  EXPECT_NE(error_with("fx 0 cx\n0 fy cy\n0 0 1\n").find("intrinsics.txt line 1 is not a row of numbers"),
+            std::string::npos);
+  EXPECT_NE(error_with("50.5 0 31.2\n0 50.7 23.9\n0 0 1\n5.38 1\n").find("the 4th line holds 2 numbers"),
+            std::string::npos);
+
+  // --stereo-depth without a baseline says what is missing, not that the right images are.
+  fs::remove_all(in / "depth01");
+  std::ofstream(in / "intrinsics.txt") << "50.5 0 31.2\n0 50.7 23.9\n0 0 1\n";
+  ImportOptions stereo = options;
+  stereo.stereo_depth = true;
+  EXPECT_NE(ImportError(stereo, out).find("--stereo-depth needs the baseline"), std::string::npos);
+
+  // A calibration file stands in for a missing intrinsics.txt.
+  fs::remove(in / "intrinsics.txt");
+  ImportOptions calibrated = options;
+  calibrated.calibration = in / "camera.json";
+  WriteCalibration(calibrated.calibration);
+  fs::remove_all(out);
+  ImportDataset(calibrated, out);
+  EXPECT_DOUBLE_EQ(SequenceReader(out).info().camera.fy(), 51);
+  fs::remove_all(in);
+  fs::remove_all(out);
+}
+
+// Endo-Depth-and-Motion's Hamlyn tracking data (color/, depth/, names without leading zeros),
+// and frames paired across folders by their numbers, not by their places in each folder.
+TEST(DatasetImport, HamlynFramesPairedByNumberInEitherLayout) {
+  const fs::path in = UniqueTempFolder("edam_in"), out = UniqueTempFolder("edam_out");
+  constexpr int kManyFrames = 12;  // past 9, where name order and number order part
+  fs::create_directories(in / "color");
+  fs::create_directories(in / "depth");
+  for (int i = 0; i < kManyFrames; ++i) {
+    cv::imwrite((in / "color" / (std::to_string(i) + ".png")).string(), Frame(i));
+    cv::imwrite((in / "depth" / (std::to_string(i) + ".png")).string(),
+                cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + 2 * i)));
+  }
+  std::ofstream(in / "intrinsics.txt") << "50.5 0 31.2\n0 50.7 23.9\n0 0 1\n";
+  const ImportOptions options = Options("hamlyn", in);
+  ImportDataset(options, out);
+  const SequenceReader sequence(out);
+  ASSERT_EQ(sequence.frame_count(), kManyFrames);
+  EXPECT_FALSE(sequence.has_right());
+  for (int i = 0; i < kManyFrames; ++i) {
+    EXPECT_EQ(sequence.ReadRgb(i).at<cv::Vec3b>(0, 0)[0], i * 20) << "frame " << i;
+    EXPECT_FLOAT_EQ(sequence.ReadDepthMm(i).at<float>(5, 5), 60.f + 2 * i) << "frame " << i;
+  }
+
+  // As many depth images as frames, but one of them of a frame that is not there.
+  fs::rename(in / "depth" / "1.png", in / "depth" / "12.png");
+  EXPECT_NE(ImportError(options, out).find("depth/ has no image of frame 1 (color/1.png)"), std::string::npos);
+  fs::rename(in / "depth" / "12.png", in / "depth" / "01.png");
+  cv::imwrite((in / "depth" / "1.png").string(), cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(62)));
+  EXPECT_NE(ImportError(options, out).find("two images of frame 1: "), std::string::npos);
+  fs::remove_all(in);
+
+  // The rectified release unpacked into a folder of its own name: the message points to it.
+  HamlynFixture(in / "rectified08" / "rectified08", [](int i) { return cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(60 + i)); });
+  const std::string nested = ImportError(Options("hamlyn", in / "rectified08"), out);
+  EXPECT_NE(nested.find("no images in image01/"), std::string::npos) << nested;
+  EXPECT_NE(nested.find((in / "rectified08" / "rectified08").string() + " has them: import that folder"), std::string::npos)
+      << nested;
+  fs::remove(in / "rectified08" / "rectified08" / "image02" / "0000000002.png");
+  cv::imwrite((in / "rectified08" / "rectified08" / "image02" / "0000000005.png").string(), Frame(5));
+  EXPECT_NE(ImportError(Options("hamlyn", in / "rectified08" / "rectified08"), out)
+                .find("image02/ has no image of frame 2 (image01/0000000002.png)"),
             std::string::npos);
   fs::remove_all(in);
   fs::remove_all(out);
@@ -301,7 +399,7 @@ TEST(DatasetImport, C3vdFramesInTheOrderOfTheirNumbersWhateverThePadding) {
             std::string::npos);
   fs::remove(in / "3_color.png");
   fs::copy_file(in / "0001_depth.tiff", in / "1_depth.tiff");
-  EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out")).find("two depth images of frame 1: "), std::string::npos);
+  EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out")).find("two images of frame 1: "), std::string::npos);
   fs::remove(in / "1_depth.tiff");
   fs::remove(in / "0001_depth.tiff");
   EXPECT_NE(ImportError(options, UniqueTempFolder("c3vd_gap_out"))

@@ -286,6 +286,8 @@ TEST(FrameNumberOf, TheLastRunOfDigitsWithOrWithoutLeadingZeros) {
   EXPECT_EQ(FrameNumberOf("12_color"), 12);
   EXPECT_EQ(FrameNumberOf("cam2_frame0045"), 45);
   EXPECT_EQ(FrameNumberOf("0"), 0);
+  EXPECT_EQ(FrameNumberOf("0000000000"), 0);
+  EXPECT_EQ(FrameNumberOf("0000000123"), 123);  // Hamlyn's ten digits
   EXPECT_EQ(FrameNumberOf("depth"), std::nullopt);
   EXPECT_EQ(FrameNumberOf("1234567890"), std::nullopt);  // past what a frame number can be
 }

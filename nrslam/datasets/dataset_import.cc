@@ -113,6 +113,24 @@ std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suff
   return files;
 }
 
+// The image files of `folders` whose stems end in `suffix`, by the frame number in their names
+// (FrameNumberOf); files without one are left out, and two files of one frame are refused.
+std::map<int, fs::path> FilesByFrame(const ImportOptions& options, const std::vector<fs::path>& folders,
+                                     const std::string& suffix = "") {
+  std::map<int, fs::path> of_frame;
+  for (const fs::path& folder : folders) {
+    for (const fs::path& file : ImageFiles(folder, suffix)) {
+      const std::optional<int> number = FrameNumberOf(file.stem().string());
+      if (!number) continue;
+      if (const auto [kept, added] = of_frame.emplace(*number, file); !added) {
+        Fail(options, "two images of frame " + std::to_string(*number) + ": " + kept->second.string() + " and " +
+                          file.string());
+      }
+    }
+  }
+  return of_frame;
+}
+
 std::vector<double> Numbers(const std::string& line) {
   std::string spaced = line;
   std::replace(spaced.begin(), spaced.end(), ',', ' ');
@@ -201,34 +219,100 @@ FrameSource EndomapperSim(const ImportOptions& options) {
   return source;
 }
 
-FrameSource Hamlyn(const ImportOptions& options) {
-  FrameSource source;
-  const std::vector<fs::path> left = ImageFiles(options.input / "image01");
-  const std::vector<fs::path> right = ImageFiles(options.input / "image02");
-  const std::vector<fs::path> depth = ImageFiles(options.input / "depth01");
-  if (left.empty()) Fail(options, "no images in image01/");
-  if (!right.empty() && right.size() != left.size()) {
-    Fail(options, "image02/ has " + std::to_string(right.size()) + " images, image01/ " + std::to_string(left.size()));
+// What a Hamlyn intrinsics.txt gives: the rectified pinhole and, when it has one, the baseline.
+struct HamlynIntrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  double baseline_mm = 0;  // 0: not given
+};
+
+// K as three rows of 3 numbers, or of 4 (a 3×4 projection matrix, whose last column says
+// nothing of K), or four rows of 4 (a homogeneous 4×4, last row 0 0 0 1); then, optionally,
+// one line holding the baseline in mm. Read by rows: taken as one list of numbers, a 3×4 put
+// 0 where fy is.
+HamlynIntrinsics ReadHamlynIntrinsics(const ImportOptions& options) {
+  std::ifstream file = OpenText(options, "intrinsics.txt");
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  for (int number = 1; std::getline(file, line); ++number) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    rows.push_back(Numbers(line));
+    if (rows.back().empty()) Fail(options, "intrinsics.txt line " + std::to_string(number) + " is not a row of numbers");
   }
-  if (!depth.empty() && depth.size() != left.size()) {
-    Fail(options, "depth01/ has " + std::to_string(depth.size()) + " images, image01/ " + std::to_string(left.size()));
+  const std::string expected =
+      "intrinsics.txt: expected K as three rows \"fx 0 cx\", \"0 fy cy\", \"0 0 1\" (each may have a 4th number, "
+      "as a 3x4 projection matrix), then optionally a line with the baseline in mm";
+  if (rows.size() < 3 || rows.size() > 4) Fail(options, expected);
+  for (int r = 0; r < 3; ++r) {
+    if (rows[r].size() != 3 && rows[r].size() != 4) Fail(options, expected);
+  }
+  if (rows[0][1] != 0 || rows[1][0] != 0 || rows[2][0] != 0 || rows[2][1] != 0 || rows[2][2] != 1) {
+    Fail(options, expected + " (a skew or a last row other than 0 0 1 is not a pinhole K)");
+  }
+  HamlynIntrinsics intrinsics{rows[0][0], rows[1][1], rows[0][2], rows[1][2]};
+  if (rows.size() == 4) {
+    const std::vector<double>& last = rows[3];
+    if (last.size() == 1) {
+      if (last[0] == 0) Fail(options, "intrinsics.txt: the baseline (after K) is 0 mm");
+      intrinsics.baseline_mm = std::abs(last[0]);
+    } else if (last != std::vector<double>{0, 0, 0, 1}) {
+      Fail(options, expected + " (the 4th line holds " + std::to_string(last.size()) + " numbers)");
+    }
+  }
+  return intrinsics;
+}
+
+// Hamlyn in either of its published layouts: the rectified release (image01/ left, image02/
+// right, depth01/) or Endo-Depth-and-Motion's tracking data (color/, depth/), both with depth
+// as 16-bit mm. Frames are paired across the folders by the number in their names.
+FrameSource Hamlyn(const ImportOptions& options) {
+  const bool edam_layout = !fs::is_directory(options.input / "image01") && fs::is_directory(options.input / "color");
+  const std::string left_folder = edam_layout ? "color" : "image01", depth_folder = edam_layout ? "depth" : "depth01";
+  FrameSource source;
+  const std::vector<fs::path> left = ImageFiles(options.input / left_folder);
+  if (!fs::is_directory(options.input)) Fail(options, "is not a folder");
+  if (left.empty()) {
+    std::string hint;  // an archive unpacked into a folder of the same name (rectified08/rectified08/)
+    for (const auto& entry : fs::directory_iterator(options.input)) {
+      if (fs::is_directory(entry.path() / "image01") || fs::is_directory(entry.path() / "color")) {
+        hint = "; " + entry.path().string() + " has them: import that folder";
+        break;
+      }
+    }
+    Fail(options, "no images in image01/ (the rectified release) or color/ (Endo-Depth-and-Motion's)" + hint);
+  }
+  const std::map<int, fs::path> right_of_frame =
+      edam_layout ? std::map<int, fs::path>() : FilesByFrame(options, {options.input / "image02"});
+  const std::map<int, fs::path> depth_of_frame = FilesByFrame(options, {options.input / depth_folder});
+  std::vector<fs::path> right, depth;
+  for (const fs::path& file : left) {
+    const std::optional<int> number = FrameNumberOf(file.stem().string());
+    if (!number) Fail(options, left_folder + "/" + file.filename().string() + " has no frame number in its name");
+    const auto pair_with = [&](const std::map<int, fs::path>& of_frame, const std::string& folder, std::vector<fs::path>* paired) {
+      if (of_frame.empty()) return;
+      const auto found = of_frame.find(*number);
+      if (found == of_frame.end()) {
+        Fail(options, folder + "/ has no image of frame " + std::to_string(*number) + " (" + left_folder + "/" +
+                          file.filename().string() + ")");
+      }
+      paired->push_back(found->second);
+    };
+    pair_with(right_of_frame, "image02", &right);
+    pair_with(depth_of_frame, depth_folder, &depth);
   }
   source.count = static_cast<int>(left.size());
-  std::ifstream intrinsics = OpenText(options, "intrinsics.txt");
-  std::vector<double> numbers;
-  std::string line;
-  while (std::getline(intrinsics, line)) {
-    const std::vector<double> row = Numbers(line);
-    numbers.insert(numbers.end(), row.begin(), row.end());
-  }
-  if (numbers.size() < 9) Fail(options, "intrinsics.txt: expected a 3x3 matrix K");
   const cv::Mat first = ReadImage(options, left[0], cv::IMREAD_COLOR);
+  // With a calibration file, intrinsics.txt (if there) gives only the baseline.
+  const bool has_intrinsics = options.calibration.empty() || fs::exists(options.input / "intrinsics.txt");
+  const HamlynIntrinsics intrinsics = has_intrinsics ? ReadHamlynIntrinsics(options) : HamlynIntrinsics();
   source.camera = options.calibration.empty()
-                      ? Camera::Pinhole(first.cols, first.rows, numbers[0], numbers[4], numbers[2], numbers[5])
+                      ? Camera::Pinhole(first.cols, first.rows, intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy)
                       : LoadCalibration(options);
   source.rgb = [&options, left](int i) { return ReadImage(options, left[i], cv::IMREAD_COLOR); };
-  if (!right.empty() && numbers.size() >= 10) {
-    source.baseline_mm = std::abs(numbers[9]);
+  if (!right.empty() && intrinsics.baseline_mm == 0 && options.stereo_depth) {
+    Fail(options, "--stereo-depth needs the baseline, which intrinsics.txt does not give (a line after K, in mm)");
+  }
+  if (!right.empty() && intrinsics.baseline_mm > 0) {
+    source.baseline_mm = intrinsics.baseline_mm;
     source.right = [&options, right](int i) { return ReadImage(options, right[i], cv::IMREAD_COLOR); };
   }
   if (!depth.empty()) {
@@ -250,17 +334,7 @@ FrameSource C3vd(const ImportOptions& options) {
   if (colour.empty()) Fail(options, "no N_color.png frames");
   // C3VD writes colour without leading zeros ("12_color.png") and depth with four
   // ("0012_depth.tiff"), in the sequence's folder or, in its later release, in depth/.
-  std::map<int, fs::path> depth_of_frame;
-  for (const fs::path& folder : {options.input, options.input / "depth"}) {
-    for (const fs::path& file : ImageFiles(folder, "_depth")) {
-      const std::optional<int> number = FrameNumberOf(file.stem().string());
-      if (!number) continue;
-      if (const auto [kept, added] = depth_of_frame.emplace(*number, file); !added) {
-        Fail(options, "two depth images of frame " + std::to_string(*number) + ": " + kept->second.string() + " and " +
-                          file.string());
-      }
-    }
-  }
+  const std::map<int, fs::path> depth_of_frame = FilesByFrame(options, {options.input, options.input / "depth"}, "_depth");
   std::vector<fs::path> depth;
   for (int frame = 0; frame < static_cast<int>(colour.size()); ++frame) {
     // pose.txt has no frame numbers: its lines are frames 0, 1, 2 …, so the images must be too.

@@ -5,8 +5,11 @@
 //                   ("tX;tY;tZ;rX;rY;rZ;rW;time", camera_from_world). Pinhole; default
 //                   intrinsics are the Endomapper simulation's (fx = fy = 472.6496, principal
 //                   point at the image centre) unless a calibration file is given.
-//   hamlyn          rectified: image01/ (left), image02/ (right), depth01/ (16-bit, mm),
-//                   intrinsics.txt (3×3 K, optionally a 4th line with the baseline in mm).
+//   hamlyn          the rectified release: image01/ (left), image02/ (right), depth01/; or
+//                   Endo-Depth-and-Motion's tracking data: color/, depth/. Depth 16-bit mm;
+//                   frames paired across folders by the numbers in their names.
+//                   intrinsics.txt: K by rows (3×3, 3×4 or 4×4), optionally then a line with
+//                   the baseline in mm (the right images are used only with it).
 //   c3vd            NNNN_color.png, NNNN_depth.tiff (16-bit, 0–65535 ↦ 0–100 mm), pose.txt
 //                   (one 4×4 world_from_camera per line, 16 numbers, mm; row- or column-major
 //                   is recognised from where the translation is). Calibration file required.

@@ -82,7 +82,9 @@ std::optional<int> FrameNumberOf(const std::string& stem) {
   while (end > 0 && !is_digit(stem[end - 1])) --end;
   size_t begin = end;
   while (begin > 0 && is_digit(stem[begin - 1])) --begin;
-  if (begin == end || end - begin > 9) return std::nullopt;
+  if (begin == end) return std::nullopt;
+  while (begin + 1 < end && stem[begin] == '0') ++begin;  // Hamlyn pads to ten digits
+  if (end - begin > 9) return std::nullopt;
   return std::stoi(stem.substr(begin, end - begin));
 }
 

@@ -41,7 +41,7 @@ std::string FrameFileName(int index);
 
 // The frame number in another program's or dataset's file name: the last run of digits in
 // the stem, leading zeros or none ("depth_000123" and "0123_depth" → 123); nothing when the
-// stem has no digits or too many for a frame number.
+// stem has no digits or its number is past 999999999.
 std::optional<int> FrameNumberOf(const std::string& stem);
 
 }  // namespace nrslam
