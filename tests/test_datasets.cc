@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <iterator>
 
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/io/sequence_reader.h"
@@ -93,6 +94,19 @@ TEST(DatasetImport, EndomapperSimulatedReversedZDepthAndInvertedPoses) {
   ASSERT_EQ(sequence.groundtruth().size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) ExpectSamePose(sequence.groundtruth()[i].world_from_camera, Pose(i), 1e-3);
   EXPECT_EQ(sequence.ReadRgb(2).at<cv::Vec3b>(0, 0)[0], 40);
+
+  // Without its header line, the file's first pose is still frame 0's.
+  std::string poses;
+  {
+    std::ifstream with_header(in / "trajectory.csv");
+    std::getline(with_header, poses);
+    poses.assign(std::istreambuf_iterator<char>(with_header), std::istreambuf_iterator<char>());
+  }
+  std::ofstream(in / "trajectory.csv") << poses;
+  fs::remove_all(out);
+  ImportDataset(options, out);
+  ASSERT_EQ(SequenceReader(out).groundtruth().size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) ExpectSamePose(SequenceReader(out).groundtruth()[i].world_from_camera, Pose(i), 1e-3);
 
   fs::remove(in / "depth" / "aov_image_0002.exr");
   EXPECT_NE(ImportError(options, out).find("missing " + (in / "depth" / "aov_image_0002.exr").string()), std::string::npos);

@@ -206,10 +206,10 @@ FrameSource EndomapperSim(const ImportOptions& options) {
   };
   std::ifstream trajectory = OpenText(options, "trajectory.csv");
   std::string line;
-  std::getline(trajectory, line);  // header
-  for (int row = 2; std::getline(trajectory, line); ++row) {
+  for (int row = 1; std::getline(trajectory, line); ++row) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::vector<double> v = Numbers(line);
+    if (row == 1 && v.empty()) continue;  // the header, when there is one: skipping a pose would shift them all
     if (v.size() < 7) Fail(options, "trajectory.csv line " + std::to_string(row) + ": expected tX;tY;tZ;rX;rY;rZ;rW;time");
     const Rigid3 camera_from_world(Eigen::Quaterniond(v[6], v[3], v[4], v[5]),
                                    Eigen::Vector3d(v[0], v[1], v[2]) * options.scene_unit_mm);
