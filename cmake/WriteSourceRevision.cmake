@@ -28,18 +28,36 @@ else()
   endif()
 endif()
 
+# 12 hex digits of a SHA-1 over BUILD_FLAVOUR and the contents of FILES (relative to
+# SOURCE_DIR), into VARIABLE.
+function(fingerprint variable files)
+  list(SORT files)
+  set(listing "${BUILD_FLAVOUR}\n")
+  foreach(file IN LISTS files)
+    file(SHA1 "${SOURCE_DIR}/${file}" file_hash)
+    string(APPEND listing "${file} ${file_hash}\n")
+  endforeach()
+  string(SHA1 hash "${listing}")
+  string(SUBSTRING "${hash}" 0 12 hash)
+  set(${variable} "${hash}" PARENT_SCOPE)
+endfunction()
+
 file(GLOB_RECURSE code_files LIST_DIRECTORIES false RELATIVE "${SOURCE_DIR}"
      "${SOURCE_DIR}/nrslam/*.h" "${SOURCE_DIR}/nrslam/*.cc" "${SOURCE_DIR}/nrslam/*.in"
      "${SOURCE_DIR}/nrslam/CMakeLists.txt" "${SOURCE_DIR}/tools/*.h" "${SOURCE_DIR}/tools/*.cc"
      "${SOURCE_DIR}/tools/CMakeLists.txt" "${SOURCE_DIR}/cmake/*.cmake")
 list(APPEND code_files CMakeLists.txt)
-list(SORT code_files)
-set(code_listing "${BUILD_FLAVOUR}\n")
-foreach(code_file IN LISTS code_files)
-  file(SHA1 "${SOURCE_DIR}/${code_file}" file_hash)
-  string(APPEND code_listing "${code_file} ${file_hash}\n")
+fingerprint(code_fingerprint "${code_files}")
+
+# @sequence_code_fingerprint@, for deciding whether a rendered or imported sequence in the
+# cache can be reused: the same over the code that makes sequences (the simulator, the
+# importers and the folders they build on, and their two tools).
+set(sequence_code_globs "${SOURCE_DIR}/tools/nrslam_simulate.cc" "${SOURCE_DIR}/tools/nrslam_import.cc")
+foreach(folder IN ITEMS sim datasets io camera geometry util)
+  list(APPEND sequence_code_globs "${SOURCE_DIR}/nrslam/${folder}/*.h" "${SOURCE_DIR}/nrslam/${folder}/*.cc"
+       "${SOURCE_DIR}/nrslam/${folder}/*.in")
 endforeach()
-string(SHA1 code_fingerprint "${code_listing}")
-string(SUBSTRING "${code_fingerprint}" 0 12 code_fingerprint)
+file(GLOB sequence_code_files LIST_DIRECTORIES false RELATIVE "${SOURCE_DIR}" ${sequence_code_globs})
+fingerprint(sequence_code_fingerprint "${sequence_code_files}")
 
 configure_file("${TEMPLATE}" "${OUTPUT}" @ONLY)

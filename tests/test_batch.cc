@@ -1857,6 +1857,9 @@ TEST(BatchEvaluation, ASweepResumesWhereItStopped) {
   const std::vector<RunResult> first = CollectResults(plan);
   ASSERT_EQ(first[0].status, "ok") << first[0].error;
   ASSERT_EQ(first[1].status, "ok") << first[1].error;
+  // The cached render records the code that made it, which is part of its key.
+  EXPECT_EQ(ReadJsonFile(plan.prepares[0].folder / "sequence.json").at("provenance").at("code"),
+            SequenceCodeFingerprint());
   // As if the second run had been interrupted: only it runs again.
   std::filesystem::remove(plan.runs[1].run_folder / "summary.json");
   const auto untouched = std::filesystem::last_write_time(plan.runs[0].run_folder / "summary.json");

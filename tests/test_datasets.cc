@@ -16,6 +16,7 @@
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/source_revision.h"
 #include "camera_fixtures.h"
 #include "error_message.h"
 #include "temp_folder.h"
@@ -140,6 +141,7 @@ TEST(DatasetImport, HamlynRectifiedStereoWithMillimetreDepth) {
   EXPECT_DOUBLE_EQ(sequence.info().stereo->baseline_mm, 5.38);
   EXPECT_FLOAT_EQ(sequence.ReadDepthMm(2).at<float>(5, 5), 62.f);
   EXPECT_FALSE(sequence.has_groundtruth());
+  EXPECT_EQ(sequence.info().provenance.at("code"), SequenceCodeFingerprint());  // which importer made it
 
   // --stereo-depth: for a Hamlyn sequence without depth01/, depth from its rectified pairs.
   options.stereo_depth = true;

@@ -191,7 +191,9 @@ int AddPrepare(const ManifestSequence& sequence, const std::filesystem::path& ca
     }
     job.description = sequence.preset;
   }
-  std::string key;
+  // The code that makes sequences is part of the key: a render or import by other code (an
+  // importer since mended, a simulator since changed) is made again, not silently reused.
+  std::string key = std::string("code ") + SequenceCodeFingerprint() + "\n";
   for (const std::string& argument : job.arguments) key += argument + "\n";
   const std::string stem = job.import ? sequence.name : sequence.preset;
   job.folder = cache_folder / (stem + "-" + StableHash(key));

@@ -25,6 +25,7 @@
 #include "nrslam/io/sequence_info.h"
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/util/error.h"
+#include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_file.h"
 
 namespace nrslam {
@@ -634,6 +635,7 @@ SequenceInfo ImportDataset(const ImportOptions& options, const fs::path& out) {
   info.depth_unit_mm = options.depth_unit_mm;
   if (source.right) info.stereo = StereoInfo{source.baseline_mm, info.camera};
   info.provenance = {{"generator", std::string("nrslam_import ") + NRSLAM_VERSION},
+                     {"code", SequenceCodeFingerprint()},
                      {"format", options.format},
                      {"source", fs::absolute(options.input).string()}};
   info.provenance.update(source.provenance);

@@ -5,6 +5,7 @@
 
 #include "nrslam/io/sequence_writer.h"
 #include "nrslam/sim/renderer.h"
+#include "nrslam/util/source_revision.h"
 
 namespace nrslam {
 
@@ -22,6 +23,7 @@ SimulationSummary SimulateSequence(const SimOptions& options, const std::string&
   info.stereo = renderer.stereo();
   if (!renderer.validity_mask().empty()) info.mask = "mask.png";
   info.provenance = {{"generator", std::string("nrslam_simulate ") + NRSLAM_VERSION},
+                     {"code", SequenceCodeFingerprint()},
                      {"preset", name},
                      {"parameters", options}};
   SequenceWriter writer(folder, info, /*with_depth=*/true);

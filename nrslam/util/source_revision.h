@@ -18,6 +18,12 @@ const char* SourceRevision();
 // finished run is reused exactly when it matches.
 const char* CodeFingerprint();
 
+// The same over the code that makes sequences alone: the simulator, the importers, the
+// folders they build on (io, camera, geometry, util) and their tools. Recorded in each
+// rendered or imported sequence.json and part of the cache's key, so that a sequence made by
+// other code is made again rather than reused, while a change to tracking or mapping keeps it.
+const char* SequenceCodeFingerprint();
+
 // "nrslam <version> (revision <SourceRevision()>, code <CodeFingerprint()>)": what the tools
 // print for --version and the benchmarks above their figures.
 std::string VersionString();
