@@ -19,6 +19,7 @@
 
 #include "nrslam/batch/baseline.h"
 #include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/plan_execution.h"
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/paired_comparison.h"
 #include "nrslam/batch/report.h"

@@ -18,6 +18,7 @@
 #include "documentation_footer.h"
 #include "nrslam/batch/baseline.h"
 #include "nrslam/batch/evaluation_plan.h"
+#include "nrslam/batch/plan_execution.h"
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"

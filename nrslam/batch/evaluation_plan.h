@@ -1,11 +1,9 @@
 // batch: what an evaluation runs — the renders of the manifest's presets into the cache and
-// one nrslam_run per (sequence, sweep point) — and running it with a few processes at a time.
+// one nrslam_run per (sequence, sweep point). Running it: plan_execution.h.
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,7 +46,7 @@ struct PrepareJob {
   std::string description;              // "sim-3" or "hamlyn /data/h01", for messages
   bool import = false;                  // nrslam_import rather than nrslam_simulate
   std::vector<std::string> arguments;   // the program's arguments, without --out
-  std::filesystem::path folder;         // cache/<name>-<hash of the arguments>
+  std::filesystem::path folder;         // cache/<name>-<hash of the arguments and SequenceCodeFingerprint()>
 };
 
 struct RunJob {
@@ -79,49 +77,5 @@ std::string RunName(const std::string& sequence, const std::string& label);
 EvaluationPlan PlanEvaluation(const Manifest& manifest, const std::vector<std::string>& extra,
                               const std::vector<Sweep>& sweeps, const std::filesystem::path& out,
                               const std::filesystem::path& cache);
-
-struct Programs {
-  std::filesystem::path simulate;  // nrslam_simulate
-  std::filesystem::path run;       // nrslam_run
-  std::filesystem::path import;    // nrslam_import
-  std::filesystem::path eval;      // nrslam_eval, which scores external results
-};
-
-// The shell command that prepares a sequence into the cache (atomically, so concurrent or
-// interrupted ones never leave a half-written sequence behind), if not there yet.
-std::string PrepareShellLine(const PrepareJob& prepare, const Programs& programs);
-// The shell command of one run, self-contained: prepares its sequence first if needed.
-std::string RunShellLine(const EvaluationPlan& plan, const RunJob& run, const Programs& programs);
-
-// A run whose folder already holds a summary.json, and a config.json with this run's options,
-// sequence and code fingerprint (CodeFingerprint()), finished before: it is not run again. A
-// folder from other options (an --out reused after changing --set or the manifest) or other
-// code is run again rather than reported stale.
-bool RunIsFinished(const RunJob& run);
-
-// What ExecutePlan would do, for `nrslam_eval --dry-run`: a line counting the sequences to
-// render or import and those already in the cache, a line counting the runs to run and those
-// finished before (RunIsFinished), then one line per sequence and per run with its state.
-std::string DescribePlan(const EvaluationPlan& plan);
-
-// A run records the code fingerprint of the nrslam_run that made it, and RunIsFinished counts
-// it only when that is this program's. An nrslam_run built from other code (one tool rebuilt
-// and not the others) would have every run it finishes count as unfinished, and run again by
-// every evaluation: throws Error naming both fingerprints. Nothing happens when the program
-// does not answer --version; the runs then fail and say why.
-void CheckRunProgramCode(const std::filesystem::path& run_program);
-
-// Prepares what is missing, then runs what is not finished, `jobs` processes at a time.
-// `progress` gets one line per finished step. Failures are recorded in the run folders
-// (failure.json), never thrown; only an nrslam_run of other code throws, before anything
-// is run (CheckRunProgramCode). A run still going after `run_timeout_seconds` (wall clock;
-// 0: no limit) is killed and recorded as failed, so one sequence that hangs cannot stall a
-// batch; it is run again by the next evaluation into the same folder. Once `*stop` is true
-// (nrslam_eval sets it on SIGINT and SIGTERM) nothing more starts, the running programs are
-// sent SIGTERM, and those runs are left unfinished without a failure: the next evaluation
-// into the same folder runs them.
-void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
-                 const std::function<void(const std::string&)>& progress, double run_timeout_seconds = 0,
-                 const std::atomic<bool>* stop = nullptr);
 
 }  // namespace nrslam
