@@ -28,7 +28,9 @@ struct HamlynIntrinsics {
 HamlynIntrinsics ReadHamlynIntrinsics(const ImportOptions& options) {
   std::vector<std::vector<double>> rows;
   for (const NumberLine& line : NumberLines(options, "intrinsics.txt")) {
-    if (line.numbers.empty()) Fail(options, "intrinsics.txt line " + std::to_string(line.line) + " is not a row of numbers");
+    if (line.numbers.empty()) {
+      Fail(options, "intrinsics.txt line " + std::to_string(line.line) + " is not a row of numbers");
+    }
     rows.push_back(line.numbers);
   }
   const std::string expected =
@@ -101,7 +103,9 @@ FrameSource EndomapperSim(const ImportOptions& options) {
     const std::vector<double>& v = line.numbers;
     // The header, when there is one: skipping the first line regardless would shift every pose.
     if (&line == &lines.front() && v.empty()) continue;
-    if (v.size() < 7) Fail(options, "trajectory.csv line " + std::to_string(line.line) + ": expected tX;tY;tZ;rX;rY;rZ;rW;time");
+    if (v.size() < 7) {
+      Fail(options, "trajectory.csv line " + std::to_string(line.line) + ": expected tX;tY;tZ;rX;rY;rZ;rW;time");
+    }
     const Rigid3 camera_from_world(Eigen::Quaterniond(v[6], v[3], v[4], v[5]),
                                    Eigen::Vector3d(v[0], v[1], v[2]) * options.scene_unit_mm);
     source.world_from_camera.push_back(camera_from_world.Inverse());
@@ -114,11 +118,13 @@ FrameSource EndomapperSim(const ImportOptions& options) {
 // right, depth01/) or Endo-Depth-and-Motion's tracking data (color/, depth/), both with depth
 // as 16-bit mm. Frames are paired across the folders by the number in their names.
 FrameSource Hamlyn(const ImportOptions& options) {
-  const bool edam_layout = !fs::is_directory(options.input / "image01") && fs::is_directory(options.input / "color");
-  const std::string left_folder = edam_layout ? "color" : "image01", depth_folder = edam_layout ? "depth" : "depth01";
+  const bool edam_layout =
+      !fs::is_directory(options.input / "image01") && fs::is_directory(options.input / "color");
+  const std::string left_folder = edam_layout ? "color" : "image01";
+  const std::string depth_folder = edam_layout ? "depth" : "depth01";
+  if (!fs::is_directory(options.input)) Fail(options, "is not a folder");
   FrameSource source;
   const std::vector<fs::path> left = ImageFiles(options.input / left_folder);
-  if (!fs::is_directory(options.input)) Fail(options, "is not a folder");
   if (left.empty()) {
     std::string hint;  // an archive unpacked into a folder of the same name (rectified08/rectified08/)
     for (const auto& entry : fs::directory_iterator(options.input)) {
@@ -132,30 +138,33 @@ FrameSource Hamlyn(const ImportOptions& options) {
   const std::map<int, fs::path> right_of_frame =
       edam_layout ? std::map<int, fs::path>() : FilesByFrame(options, {options.input / "image02"});
   const std::map<int, fs::path> depth_of_frame = FilesByFrame(options, {options.input / depth_folder});
+  // The file of `folder` (`of_frame`, empty when the folder has none) with the left image's frame number.
+  const auto pair_with = [&](const fs::path& left_file, int number, const std::map<int, fs::path>& of_frame,
+                             const std::string& folder, std::vector<fs::path>* paired) {
+    if (of_frame.empty()) return;
+    const auto found = of_frame.find(number);
+    if (found == of_frame.end()) {
+      Fail(options, folder + "/ has no image of frame " + std::to_string(number) + " (" + left_folder + "/" +
+                        left_file.filename().string() + ")");
+    }
+    paired->push_back(found->second);
+  };
   std::vector<fs::path> right, depth;
   for (const fs::path& file : left) {
     const std::optional<int> number = FrameNumberOf(file.stem().string());
     if (!number) Fail(options, left_folder + "/" + file.filename().string() + " has no frame number in its name");
-    const auto pair_with = [&](const std::map<int, fs::path>& of_frame, const std::string& folder, std::vector<fs::path>* paired) {
-      if (of_frame.empty()) return;
-      const auto found = of_frame.find(*number);
-      if (found == of_frame.end()) {
-        Fail(options, folder + "/ has no image of frame " + std::to_string(*number) + " (" + left_folder + "/" +
-                          file.filename().string() + ")");
-      }
-      paired->push_back(found->second);
-    };
-    pair_with(right_of_frame, "image02", &right);
-    pair_with(depth_of_frame, depth_folder, &depth);
+    pair_with(file, *number, right_of_frame, "image02", &right);
+    pair_with(file, *number, depth_of_frame, depth_folder, &depth);
   }
   source.count = static_cast<int>(left.size());
   const cv::Mat first = ReadImage(options, left[0], cv::IMREAD_COLOR);
   // With a calibration file, intrinsics.txt (if there) gives only the baseline.
   const bool has_intrinsics = options.calibration.empty() || fs::exists(options.input / "intrinsics.txt");
   const HamlynIntrinsics intrinsics = has_intrinsics ? ReadHamlynIntrinsics(options) : HamlynIntrinsics();
-  source.camera = options.calibration.empty()
-                      ? Camera::Pinhole(first.cols, first.rows, intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy)
-                      : LoadCalibration(options);
+  source.camera =
+      options.calibration.empty()
+          ? Camera::Pinhole(first.cols, first.rows, intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy)
+          : LoadCalibration(options);
   source.rgb = [&options, left](int i) { return ReadImage(options, left[i], cv::IMREAD_COLOR); };
   if (!right.empty() && intrinsics.baseline_mm == 0 && options.stereo_depth) {
     Fail(options, "--stereo-depth needs the baseline, which intrinsics.txt does not give (a line after K, in mm)");
@@ -183,7 +192,8 @@ FrameSource C3vd(const ImportOptions& options) {
   if (colour.empty()) Fail(options, "no N_color.png frames");
   // C3VD writes colour without leading zeros ("12_color.png") and depth with four
   // ("0012_depth.tiff"), in the sequence's folder or, in its later release, in depth/.
-  const std::map<int, fs::path> depth_of_frame = FilesByFrame(options, {options.input, options.input / "depth"}, "_depth");
+  const std::map<int, fs::path> depth_of_frame =
+      FilesByFrame(options, {options.input, options.input / "depth"}, "_depth");
   std::vector<fs::path> depth;
   for (int frame = 0; frame < static_cast<int>(colour.size()); ++frame) {
     // pose.txt has no frame numbers: its lines are frames 0, 1, 2 …, so the images must be too.
@@ -210,7 +220,9 @@ FrameSource C3vd(const ImportOptions& options) {
   };
   for (const NumberLine& line : NumberLines(options, "pose.txt")) {
     const std::vector<double>& v = line.numbers;
-    if (v.size() != 16) Fail(options, "pose.txt line " + std::to_string(line.line) + ": expected 16 numbers (a 4x4 matrix)");
+    if (v.size() != 16) {
+      Fail(options, "pose.txt line " + std::to_string(line.line) + ": expected 16 numbers (a 4x4 matrix)");
+    }
     // Row-major keeps the translation in entries 3, 7, 11; column-major in 12, 13, 14.
     const bool column_major = std::abs(v[12]) + std::abs(v[13]) + std::abs(v[14]) > std::abs(v[3]) + std::abs(v[7]) + std::abs(v[11]);
     Eigen::Matrix4d matrix;
