@@ -1,4 +1,4 @@
-// nrslam_import: converts a public dataset on disk (Endomapper simulated, Hamlyn rectified,
+// nrslam_import: converts a public dataset on disk (Endomapper simulated, Hamlyn in either layout,
 // C3VD, a plain video / image folder with a calibration, or a raw stereo recording with its
 // stereo calibration, rectified) into a sequence folder that nrslam_run and nrslam_eval read.
 #include <CLI/CLI.hpp>
