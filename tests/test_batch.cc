@@ -19,9 +19,9 @@
 
 #include "nrslam/batch/baseline.h"
 #include "nrslam/batch/evaluation_plan.h"
-#include "nrslam/batch/plan_execution.h"
 #include "nrslam/batch/manifest.h"
 #include "nrslam/batch/paired_comparison.h"
+#include "nrslam/batch/plan_execution.h"
 #include "nrslam/batch/report.h"
 #include "nrslam/batch/results.h"
 #include "nrslam/batch/results_diff.h"

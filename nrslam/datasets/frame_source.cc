@@ -3,12 +3,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <fstream>
 #include <optional>
 #include <sstream>
-#include <string_view>
 
 #include "nrslam/io/camera_file.h"
 #include "nrslam/io/sequence_info.h"
@@ -19,31 +17,6 @@ namespace nrslam::importer {
 namespace fs = std::filesystem;
 
 namespace {
-
-bool IsDigit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
-
-// Name order that reads each run of digits as a number (see ImageFiles).
-bool NumberAwareLess(const std::string& a, const std::string& b) {
-  size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (!IsDigit(a[i]) || !IsDigit(b[j])) {
-      if (a[i] != b[j]) return a[i] < b[j];
-      ++i, ++j;
-      continue;
-    }
-    size_t end_a = i, end_b = j;
-    while (end_a < a.size() && IsDigit(a[end_a])) ++end_a;
-    while (end_b < b.size() && IsDigit(b[end_b])) ++end_b;
-    while (i + 1 < end_a && a[i] == '0') ++i;
-    while (j + 1 < end_b && b[j] == '0') ++j;
-    const std::string_view number_a(a.data() + i, end_a - i), number_b(b.data() + j, end_b - j);
-    if (number_a.size() != number_b.size()) return number_a.size() < number_b.size();
-    if (number_a != number_b) return number_a < number_b;
-    i = end_a, j = end_b;
-  }
-  if (i == a.size() && j == b.size()) return a < b;
-  return i == a.size();
-}
 
 std::vector<double> Numbers(const std::string& line) {
   std::string spaced = line;
@@ -98,7 +71,7 @@ std::vector<fs::path> ImageFiles(const fs::path& folder, const std::string& suff
     if (entry.is_regular_file() && image && matches) files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
-    return NumberAwareLess(a.filename().string(), b.filename().string());
+    return FrameNameLess(a.filename().string(), b.filename().string());
   });
   return files;
 }

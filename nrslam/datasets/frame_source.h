@@ -44,10 +44,8 @@ FrameSource Stereo(const ImportOptions& options);
 // cv::imread, failing with the file's name when it is missing or cannot be decoded.
 cv::Mat ReadImage(const ImportOptions& options, const std::filesystem::path& file, int flags);
 
-// The image files of a folder (none when it is not one) whose stems end in `suffix`, in the
-// order of the numbers in their names: "frame_2.png" before "frame_10.png", so folders
-// numbered without leading zeros (ffmpeg's %d, C3VD's "12_color.png") keep their frames'
-// order. Names that differ only in leading zeros fall back to plain order.
+// The image files of a folder (none when it is not one) whose stems end in `suffix`, in
+// FrameNameLess order (io/sequence_info.h): "frame_2.png" before "frame_10.png".
 std::vector<std::filesystem::path> ImageFiles(const std::filesystem::path& folder, const std::string& suffix = "");
 
 // The image files of `folders` whose stems end in `suffix`, by the frame number in their names

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <string_view>
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
@@ -14,6 +15,8 @@ namespace {
 // would misread, so it is refused rather than run.
 constexpr const char* kSequenceFormat = "nrslam-sequence";
 constexpr int kSequenceVersion = 1;
+
+bool IsDigit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
 
 }  // namespace
 
@@ -77,15 +80,36 @@ void from_json(const nlohmann::json& j, SequenceInfo& info) {
 }
 
 std::optional<int> FrameNumberOf(const std::string& stem) {
-  const auto is_digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
   size_t end = stem.size();
-  while (end > 0 && !is_digit(stem[end - 1])) --end;
+  while (end > 0 && !IsDigit(stem[end - 1])) --end;
   size_t begin = end;
-  while (begin > 0 && is_digit(stem[begin - 1])) --begin;
+  while (begin > 0 && IsDigit(stem[begin - 1])) --begin;
   if (begin == end) return std::nullopt;
   while (begin + 1 < end && stem[begin] == '0') ++begin;  // Hamlyn pads to ten digits
   if (end - begin > 9) return std::nullopt;
   return std::stoi(stem.substr(begin, end - begin));
+}
+
+bool FrameNameLess(const std::string& a, const std::string& b) {
+  size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (!IsDigit(a[i]) || !IsDigit(b[j])) {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i, ++j;
+      continue;
+    }
+    size_t end_a = i, end_b = j;
+    while (end_a < a.size() && IsDigit(a[end_a])) ++end_a;
+    while (end_b < b.size() && IsDigit(b[end_b])) ++end_b;
+    while (i + 1 < end_a && a[i] == '0') ++i;
+    while (j + 1 < end_b && b[j] == '0') ++j;
+    const std::string_view number_a(a.data() + i, end_a - i), number_b(b.data() + j, end_b - j);
+    if (number_a.size() != number_b.size()) return number_a.size() < number_b.size();
+    if (number_a != number_b) return number_a < number_b;
+    i = end_a, j = end_b;
+  }
+  if (i == a.size() && j == b.size()) return a < b;
+  return i == a.size();
 }
 
 std::string FrameFileName(int index) {

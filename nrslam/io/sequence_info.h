@@ -44,4 +44,9 @@ std::string FrameFileName(int index);
 // stem has no digits or its number is past 999999999.
 std::optional<int> FrameNumberOf(const std::string& stem);
 
+// Name order that reads each run of digits as a number, so that "frame_2.png" comes before
+// "frame_10.png": folders numbered without leading zeros (ffmpeg's %d, C3VD's "12_color.png")
+// keep their frames' order. Names that differ only in leading zeros fall back to plain order.
+bool FrameNameLess(const std::string& a, const std::string& b);
+
 }  // namespace nrslam

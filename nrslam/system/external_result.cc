@@ -4,7 +4,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <map>
