@@ -6,7 +6,8 @@
 // elsewhere); `nrslam_eval compare RUN_A RUN_B` scores two runs of one sequence on the points
 // both report; `nrslam_eval diff EVAL_A EVAL_B` sets two evaluations of the same runs side by
 // side, run for run; `nrslam_eval score SEQUENCE ESTIMATES --out DIR` scores another system's
-// output as a run.
+// output as a run; `nrslam_eval cache [--prune]` lists the sequences in the cache and the code
+// that made each, and removes those of other code.
 #include <CLI/CLI.hpp>
 
 #include <atomic>
@@ -26,6 +27,7 @@
 #include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/seed_groups.h"
+#include "nrslam/batch/sequence_cache.h"
 #include "nrslam/system/external_result.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
@@ -192,10 +194,25 @@ int main(int argc, char** argv) {
   score->add_option("--stride", external.depth_stride_px, "depth images: one point every this many pixels")
       ->capture_default_str();
   score->add_option("--name", external.name, "what produced it, recorded in config.json (e.g. DefSLAM)");
+  CLI::App* cache_command = app.add_subcommand(
+      "cache", "list the sequences in the cache (--cache) with the code that made each, when, and their size");
+  cache_command->fallthrough();  // --cache given after "cache"
+  bool prune = false;
+  cache_command->add_flag("--prune", prune,
+                          "remove the sequences made by other code than this build's, which it never reads again, "
+                          "and their logs");
   CLI11_PARSE(app, argc, argv);
 
   try {
     if (compare->parsed()) return Compare(compared[0], compared[1]);
+    if (cache_command->parsed()) {
+      const nrslam::CacheContents contents = nrslam::ReadCacheContents(cache);
+      std::cout << nrslam::DescribeCache(cache, contents);
+      if (!prune) return 0;
+      const nrslam::CachePruning pruning = nrslam::RemoveSequencesOfOtherCode(cache, contents);
+      std::cout << nrslam::DescribePruning(pruning);
+      return pruning.failures.empty() ? 0 : 1;
+    }
     if (score->parsed()) {
       if (app.count("--out") == 0) throw nrslam::Error("score writes a run folder: give it with --out");
       const nrslam::RunSummary summary =

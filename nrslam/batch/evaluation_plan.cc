@@ -1,17 +1,16 @@
 #include "nrslam/batch/evaluation_plan.h"
 
 #include <algorithm>
-#include <iomanip>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <string_view>
 
+#include "nrslam/batch/sequence_cache.h"
 #include "nrslam/sim/sim_options.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
-#include "nrslam/util/source_revision.h"
 
 namespace nrslam {
 namespace {
@@ -28,18 +27,6 @@ void OverrideAssignment(std::vector<std::string>* simulate, const std::string& a
                   simulate->end());
   simulate->push_back(assignment);
   std::sort(simulate->begin(), simulate->end());
-}
-
-// FNV-1a: a cache key that is the same on every machine and build.
-std::string StableHash(const std::string& text) {
-  uint64_t hash = 1469598103934665603ull;
-  for (unsigned char c : text) {
-    hash ^= c;
-    hash *= 1099511628211ull;
-  }
-  std::ostringstream hex;
-  hex << std::hex << std::setw(16) << std::setfill('0') << hash;
-  return hex.str().substr(0, 12);
 }
 
 std::vector<std::string> SplitList(const std::string& text) {
@@ -165,12 +152,7 @@ int AddPrepare(const ManifestSequence& sequence, const std::filesystem::path& ca
     }
     job.description = sequence.preset;
   }
-  // The code that makes sequences is part of the key: a render or import by other code (an
-  // importer since mended, a simulator since changed) is made again, not silently reused.
-  std::string key = std::string("code ") + SequenceCodeFingerprint() + "\n";
-  for (const std::string& argument : job.arguments) key += argument + "\n";
-  const std::string stem = job.import ? sequence.name : sequence.preset;
-  job.folder = cache_folder / (stem + "-" + StableHash(key));
+  job.folder = CachedSequenceFolder(cache_folder, job.import ? sequence.name : sequence.preset, job.arguments);
   for (size_t i = 0; i < plan->prepares.size(); ++i) {
     if (plan->prepares[i].folder == job.folder) return static_cast<int>(i);
   }

@@ -1,7 +1,5 @@
 #include "nrslam/batch/plan_execution.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <atomic>
 #include <fstream>
@@ -9,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "nrslam/batch/sequence_cache.h"
 #include "nrslam/io/sequence_info.h"
 #include "nrslam/system/system_options.h"
 #include "nrslam/util/error.h"
@@ -38,40 +37,6 @@ std::string LastLine(const std::filesystem::path& log) {
     if (line.find_first_not_of(" \t") != std::string::npos) last = line;
   }
   return last;
-}
-
-std::string HostName() {
-  char host[256] = {};
-  ::gethostname(host, sizeof(host) - 1);
-  return host;
-}
-
-// Where a sequence is prepared before it is moved into place: <folder>.partial.<host>-<pid>-<n>.
-// Evaluations that share a cache may prepare the same sequence at once; each writes only into a
-// folder of its own.
-std::filesystem::path PartialFolder(const std::filesystem::path& folder) {
-  static std::atomic<int> count{0};
-  return folder.string() + ".partial." + HostName() + "-" + std::to_string(::getpid()) + "-" +
-         std::to_string(count++);
-}
-
-// Removes the partial folders (and their logs) in `cache` that interrupted evaluations on this
-// machine left behind: those whose process is gone. A cache shared between machines keeps the
-// others'.
-void RemoveAbandonedPartials(const std::filesystem::path& cache) {
-  const std::string marker = ".partial." + HostName() + "-";
-  std::error_code unreadable;
-  for (const auto& entry : std::filesystem::directory_iterator(cache, unreadable)) {
-    const std::string name = entry.path().filename().string();
-    const size_t at = name.find(marker);
-    if (at == std::string::npos) continue;
-    const std::string pid = name.substr(at + marker.size(), name.find('-', at + marker.size()) - at - marker.size());
-    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) continue;
-    if (!ProcessIsRunning(std::stoi(pid))) {
-      std::error_code ignored;
-      std::filesystem::remove_all(entry.path(), ignored);
-    }
-  }
 }
 
 const std::filesystem::path& ProgramOf(const RunJob& run, const Programs& programs) {
