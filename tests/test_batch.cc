@@ -28,6 +28,7 @@
 #include "nrslam/batch/rigid_comparison.h"
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/seed_groups.h"
+#include "nrslam/batch/sequence_cache.h"
 #include "nrslam/batch/svg_plot.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/system/system_options.h"
@@ -2023,6 +2024,89 @@ TEST(BatchEvaluation, EvaluationsSharingACacheRenderTheSameSequencesAtOnce) {
   WriteFile(late, "interrupted");
   ExecutePlan(first, programs, 2, [](const std::string&) {});
   EXPECT_FALSE(std::filesystem::exists(late));
+  // The cache's survey knows both renders for this build's: nothing for --prune to remove.
+  const CacheContents contents = ReadCacheContents(folder / "cache");
+  ASSERT_EQ(contents.sequences.size(), 2u);
+  for (const CachedSequence& made : contents.sequences) EXPECT_TRUE(made.MadeByThisCode()) << made.code;
+  EXPECT_EQ(contents.others, std::vector<std::filesystem::path>{live});
+  std::filesystem::remove_all(folder);
+}
+
+// `nrslam_eval cache` lists what an evaluation left in its cache, by the code that made each
+// sequence, and --prune removes the sequences this build would never read again (each with its
+// log), and nothing that is not an evaluation's sequence.
+TEST(SequenceCache, ListsEachSequenceByItsCodeAndPrunesOnlyThoseOfOtherCode) {
+  const auto folder = UniqueTempFolder("sequence_cache");
+  const std::filesystem::path cache = folder / "cache";
+  const auto sequence = [&](const std::string& name, const std::string& description) {
+    WriteFile(cache / name / "sequence.json", description);
+    WriteFile(cache / name / "rgb" / "000000.png", std::string(1000, 'x'));
+    WriteFile(cache / (name + ".log"), "rendered");
+  };
+  const std::filesystem::path current = CachedSequenceFolder(cache, "sim-1", {"--preset", "sim-1"});
+  const std::string this_code = std::string(R"({"provenance": {"code": ")") + SequenceCodeFingerprint() + "\"}}";
+  sequence(current.filename().string(), this_code);
+  sequence("sim-2-0123456789ab", R"({"provenance": {"code": "0123456789ab"}})");
+  sequence("sim-3-00000000000b", R"({"provenance": {"generator": "nrslam_simulate 0.1.0"}})");  // before codes were kept
+  sequence("sim-4-00000000000c", "{");                                                           // damaged
+  // Not an evaluation's sequence: someone's own folder, a folder without its description, the log
+  // of a render that failed, a partial render of a live evaluation and a file.
+  sequence("my-data", this_code);
+  WriteFile(cache / "sim-5-00000000000d" / "rgb" / "000000.png", "x");
+  WriteFile(cache / "sim-6-00000000000e.log", "rendering sim-6 failed");
+  char host[256] = {};
+  ::gethostname(host, sizeof(host) - 1);
+  const std::filesystem::path live = current.string() + ".partial." + host + "-" + std::to_string(::getpid()) + "-0";
+  WriteFile(live / "sequence.json", "{}");
+  WriteFile(cache / "notes.txt", "mine");
+  // An interrupted evaluation's partial render, which any evaluation into the cache removes.
+  WriteFile(std::filesystem::path(current.string() + ".partial." + host + "-999999999-0") / "sequence.json", "{}");
+
+  const CacheContents contents = ReadCacheContents(cache);
+  std::vector<std::string> names, codes;
+  for (const CachedSequence& s : contents.sequences) {
+    names.push_back(s.folder.filename().string());
+    codes.push_back(s.code);
+    EXPECT_EQ(s.bytes, FileText(s.folder / "sequence.json").size() + 1000 + 8) << s.folder;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{current.filename().string(), "sim-2-0123456789ab", "sim-3-00000000000b",
+                                             "sim-4-00000000000c"}));
+  EXPECT_EQ(codes, (std::vector<std::string>{SequenceCodeFingerprint(), "0123456789ab", "", ""}));
+  std::set<std::string> others;
+  for (const std::filesystem::path& other : contents.others) others.insert(other.filename().string());
+  const std::set<std::string> left_alone = {"my-data", "my-data.log", "sim-5-00000000000d", "sim-6-00000000000e.log",
+                                            live.filename().string(), "notes.txt"};
+  std::set<std::string> expected_others = left_alone;
+  expected_others.insert(current.filename().string() + ".partial." + host + "-999999999-0");
+  EXPECT_EQ(others, expected_others);
+
+  const std::string listing = DescribeCache(cache, contents);
+  EXPECT_NE(listing.find(": 4 sequence(s)"), std::string::npos) << listing;
+  EXPECT_NE(listing.find("1 made by this build's code (" + std::string(SequenceCodeFingerprint()) + ")"),
+            std::string::npos) << listing;
+  EXPECT_NE(listing.find("3 by other code"), std::string::npos) << listing;
+  EXPECT_NE(listing.find("sim-2-0123456789ab  0123456789ab"), std::string::npos) << listing;
+  EXPECT_NE(listing.find("sim-3-00000000000b  not recorded"), std::string::npos) << listing;
+  EXPECT_NE(listing.find("my-data, "), std::string::npos) << listing;
+  // The program prints the same listing, and changes nothing without --prune.
+  const auto [status, printed] =
+      RunCaught(std::string(NRSLAM_TOOLS_DIR) + "/nrslam_eval cache --cache " + cache.string(), folder / "log.txt");
+  EXPECT_EQ(status, 0) << printed;
+  EXPECT_EQ(printed, listing);
+
+  const auto [pruned, pruning] = RunCaught(
+      std::string(NRSLAM_TOOLS_DIR) + "/nrslam_eval cache --prune --cache " + cache.string(), folder / "log.txt");
+  EXPECT_EQ(pruned, 0) << pruning;
+  std::uintmax_t freed = 0;
+  for (const CachedSequence& s : contents.sequences) freed += s.MadeByThisCode() ? 0 : s.bytes;
+  EXPECT_NE(pruning.find("removed 3 sequence(s), " + FormatFixed(freed / 1e6, 1) + " MB"), std::string::npos)
+      << pruning;
+  std::set<std::string> kept;
+  for (const auto& entry : std::filesystem::directory_iterator(cache)) kept.insert(entry.path().filename().string());
+  std::set<std::string> expected_kept = left_alone;
+  expected_kept.insert({current.filename().string(), current.filename().string() + ".log"});
+  EXPECT_EQ(kept, expected_kept);
+  ExpectRefused([&] { ReadCacheContents(folder / "none"); }, "the cache " + (folder / "none").string() + " is not a folder");
   std::filesystem::remove_all(folder);
 }
 

@@ -163,7 +163,9 @@ std::string DescribeCache(const std::filesystem::path& cache, const CacheContent
   if (!contents.others.empty()) {
     std::vector<std::string> names;
     for (const std::filesystem::path& path : contents.others) names.push_back(path.filename().string());
-    text << "Left alone, not sequences of an evaluation (or being made now): " << Join(names, ", ") << '\n';
+    text << "Not an evaluation's sequences, which --prune leaves (but for partial renders an interrupted evaluation on "
+            "this machine left): "
+         << Join(names, ", ") << '\n';
   }
   return text.str();
 }
