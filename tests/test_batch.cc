@@ -2106,7 +2106,8 @@ TEST(SequenceCache, ListsEachSequenceByItsCodeAndPrunesOnlyThoseOfOtherCode) {
   std::set<std::string> expected_kept = left_alone;
   expected_kept.insert({current.filename().string(), current.filename().string() + ".log"});
   EXPECT_EQ(kept, expected_kept);
-  ExpectRefused([&] { ReadCacheContents(folder / "none"); }, "the cache " + (folder / "none").string() + " is not a folder");
+  ExpectRefused([&] { ReadCacheContents(folder / "none"); }, "the cache " + (folder / "none").string() + " does not exist");
+  ExpectRefused([&] { ReadCacheContents(folder / "log.txt"); }, "the cache " + (folder / "log.txt").string() + " is not a folder");
   std::filesystem::remove_all(folder);
 }
 

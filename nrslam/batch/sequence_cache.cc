@@ -112,6 +112,9 @@ void RemoveAbandonedPartials(const std::filesystem::path& cache) {
 bool CachedSequence::MadeByThisCode() const { return code == SequenceCodeFingerprint(); }
 
 CacheContents ReadCacheContents(const std::filesystem::path& cache) {
+  if (!std::filesystem::exists(cache)) {
+    throw Error("the cache " + cache.string() + " does not exist: no evaluation has rendered or imported into it");
+  }
   if (!std::filesystem::is_directory(cache)) throw Error("the cache " + cache.string() + " is not a folder");
   std::vector<std::filesystem::path> entries;
   for (const auto& entry : std::filesystem::directory_iterator(cache)) entries.push_back(entry.path());

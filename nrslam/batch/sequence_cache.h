@@ -49,7 +49,7 @@ struct CacheContents {
   std::vector<std::filesystem::path> others;
 };
 
-// Throws Error when `cache` is not a folder.
+// Throws Error when `cache` does not exist or is not a folder.
 CacheContents ReadCacheContents(const std::filesystem::path& cache);
 
 // One line per sequence (its name, the code that made it, when, its size), then the totals of
