@@ -2047,8 +2047,9 @@ TEST(SequenceCache, ListsEachSequenceByItsCodeAndPrunesOnlyThoseOfOtherCode) {
   const std::string this_code = std::string(R"({"provenance": {"code": ")") + SequenceCodeFingerprint() + "\"}}";
   sequence(current.filename().string(), this_code);
   sequence("sim-2-0123456789ab", R"({"provenance": {"code": "0123456789ab"}})");
-  sequence("sim-3-00000000000b", R"({"provenance": {"generator": "nrslam_simulate 0.1.0"}})");  // before codes were kept
-  sequence("sim-4-00000000000c", "{");                                                           // damaged
+  // Made before sequences recorded their code, and damaged.
+  sequence("sim-3-00000000000b", R"({"provenance": {"generator": "nrslam_simulate 0.1.0"}})");
+  sequence("sim-4-00000000000c", "{");
   // Not an evaluation's sequence: someone's own folder, a folder without its description, the log
   // of a render that failed, a partial render of a live evaluation and a file.
   sequence("my-data", this_code);
@@ -2106,8 +2107,10 @@ TEST(SequenceCache, ListsEachSequenceByItsCodeAndPrunesOnlyThoseOfOtherCode) {
   std::set<std::string> expected_kept = left_alone;
   expected_kept.insert({current.filename().string(), current.filename().string() + ".log"});
   EXPECT_EQ(kept, expected_kept);
-  ExpectRefused([&] { ReadCacheContents(folder / "none"); }, "the cache " + (folder / "none").string() + " does not exist");
-  ExpectRefused([&] { ReadCacheContents(folder / "log.txt"); }, "the cache " + (folder / "log.txt").string() + " is not a folder");
+  ExpectRefused([&] { ReadCacheContents(folder / "none"); },
+                "the cache " + (folder / "none").string() + " does not exist");
+  ExpectRefused([&] { ReadCacheContents(folder / "log.txt"); },
+                "the cache " + (folder / "log.txt").string() + " is not a folder");
   std::filesystem::remove_all(folder);
 }
 
