@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <numeric>
@@ -447,6 +448,31 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
   // and byte-order mark, Windows line ends.
   EXPECT_EQ(error_of("frame, u, v, z\n0, 10, 20, 30\n"), "no error");
   EXPECT_EQ(error_of("\xEF\xBB\xBF\"frame\",\"u\",\"v\",\"z\"\r\n0,10,20,30\r\n"), "no error");
+  // Pixels that cannot be the image's: u and v swapped (2 of 10 beyond the 240 rows), or
+  // normalised coordinates, would be scored against the wrong pixels' ground truth.
+  const auto rows = [](int count, const std::function<std::string(int)>& row) {
+    std::string csv = "frame,u,v,z\n";
+    for (int i = 0; i < count; ++i) csv += row(i) + "\n";
+    return csv;
+  };
+  ASSERT_EQ(SequenceReader(*base_ / "sequence").info().camera.height(), 240);
+  const std::string swapped = error_of(rows(10, [](int i) { return "0,10," + std::to_string(30 * i) + ",30"; }));
+  EXPECT_NE(swapped.find("2 of its 10 estimates lie outside the 320x240 image (u 10.0 … 10.0, v 0.0 … 270.0)"),
+            std::string::npos) << swapped;
+  const std::string normalised = error_of(rows(10, [](int i) { return "0,0." + std::to_string(i) + ",0.5,30"; }));
+  EXPECT_NE(normalised.find("all 10 estimates lie within two pixels of each other"), std::string::npos) << normalised;
+  EXPECT_NE(normalised.find("not normalised coordinates"), std::string::npos) << normalised;
+  // One of twenty outside (a point leaving the view) is left out and noted.
+  std::ofstream(*base_ / "one_outside.csv")
+      << rows(20, [](int i) { return "0," + std::to_string(i == 0 ? 320 : 15 * i) + ",100,30"; });
+  ExternalResult one_outside;
+  one_outside.estimates = *base_ / "one_outside.csv";
+  const RunSummary noted =
+      ScoreExternalResult(*base_ / "sequence", one_outside, EvaluationOptions{}, *base_ / "scored_one_outside");
+  EXPECT_EQ(noted.input.estimates_outside_image, 1);
+  EXPECT_NE(DescribeSummary(noted).find("1 estimate lay outside the image and were left out"), std::string::npos)
+      << DescribeSummary(noted);
+  EXPECT_EQ(ReadPointsCsv(*base_ / "scored_one_outside" / "points.csv").size(), 19u);
   ExternalResult images;
   images.estimates = *base_ / "wrong_size";
   fs::create_directories(images.estimates);

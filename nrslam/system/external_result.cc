@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -51,8 +52,40 @@ void CheckFrame(double frame, int frame_count, const std::string& where) {
   }
 }
 
+// Refuses estimates whose pixels cannot be the image's: more than a tenth outside it (u and v
+// swapped put a quarter of a 4:3 view's outside, another image size more), or all within two
+// pixels (normalised coordinates). Scored, they would give the error against the wrong pixels'
+// ground truth, or none, without a word. A few outside (a system that reports points leaving
+// the view) are left out and counted.
+void CheckPixelsAreTheImages(const fs::path& file, const std::vector<cv::Point2d>& pixels, int outside,
+                             const cv::Size& size) {
+  if (pixels.empty()) return;
+  cv::Point2d low = pixels.front(), high = pixels.front();
+  for (const cv::Point2d& pixel : pixels) {
+    low = {std::min(low.x, pixel.x), std::min(low.y, pixel.y)};
+    high = {std::max(high.x, pixel.x), std::max(high.y, pixel.y)};
+  }
+  std::ostringstream where;
+  where << std::fixed << std::setprecision(1) << "u " << low.x << " … " << high.x << ", v " << low.y << " … " << high.y;
+  const std::string expected = "u and v are expected in the image's pixels, u across and v down, (0,0) the centre "
+                               "of the top-left pixel";
+  const std::string count = std::to_string(pixels.size());
+  if (10 * static_cast<size_t>(outside) > pixels.size()) {
+    throw Error(file.string() + ": " + std::to_string(outside) + " of its " + count + " estimates lie outside the " +
+                std::to_string(size.width) + "x" + std::to_string(size.height) + " image (" + where.str() + "): " +
+                expected);
+  }
+  constexpr size_t kFewestToJudgeSpread = 10;
+  if (pixels.size() >= kFewestToJudgeSpread && high.x - low.x < 2 && high.y - low.y < 2) {
+    throw Error(file.string() + ": all " + count + " estimates lie within two pixels of each other (" + where.str() +
+                "): " + expected + ", not normalised coordinates");
+  }
+}
+
 // `has_point_ids`: whether the file has its own point_id column (else ids number rows).
-FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_point_ids) {
+// `outside`: the estimates left out because their pixel lies outside the image.
+FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, const cv::Size& size, bool* has_point_ids,
+                             int* outside) {
   std::ifstream in = OpenToRead(file, "CSV file");
   int line = 0;
   std::vector<std::string> header, fields;
@@ -78,6 +111,8 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
   const size_t id_column = has_ids ? column.at("point_id") : 0;
   const size_t needed = std::max({frame_column, u_column, v_column, z_column, id_column}) + 1;
   FrameEstimates estimates;
+  std::vector<cv::Point2d> pixels;
+  *outside = 0;
   while (ReadCsvRecord(in, file.string(), &line, &fields)) {
     const std::string where = file.string() + ":" + std::to_string(line);
     if (fields.size() < needed) {
@@ -93,8 +128,15 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, bool* has_po
     std::vector<EstimatedPoint>& points = estimates[static_cast<int>(frame)];
     const double u = number(u_column), v = number(v_column), z = number(z_column);
     const auto id = has_ids ? static_cast<int64_t>(number(id_column)) : static_cast<int64_t>(points.size());
-    if (std::isfinite(u) && std::isfinite(v) && std::isfinite(z) && z > 0) points.push_back({id, {u, v}, z});
+    if (!(std::isfinite(u) && std::isfinite(v) && std::isfinite(z) && z > 0)) continue;
+    pixels.emplace_back(u, v);
+    if (u < -0.5 || v < -0.5 || u > size.width - 0.5 || v > size.height - 0.5) {
+      ++*outside;
+    } else {
+      points.push_back({id, {u, v}, z});
+    }
   }
+  CheckPixelsAreTheImages(file, pixels, *outside, size);
   return estimates;
 }
 
@@ -205,10 +247,11 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   // Only a CSV with its own point_id column names points: depth images number pixels, and a
   // CSV without ids numbers rows. Recorded, so that nothing pairs such ids across runs.
   bool ids_name_points = false;
+  int outside_image = 0;
   const FrameEstimates estimates =
       fs::is_directory(result.estimates)
           ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
-          : ReadPointsCsv(result.estimates, reader.frame_count(), &ids_name_points);
+          : ReadPointsCsv(result.estimates, reader.frame_count(), size, &ids_name_points, &outside_image);
   const std::map<int, Rigid3> poses =
       result.trajectory.empty() ? std::map<int, Rigid3>{} : ReadTrajectory(result.trajectory, info.fps, reader.frame_count());
 
@@ -223,6 +266,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
 
   RunSummary summary;
   summary.frames_total = reader.frame_count();
+  summary.input.estimates_outside_image = outside_image;
   std::vector<FrameEvaluation> evaluations;
   std::vector<StampedPose> trajectory;
   std::vector<TrajectorySegment> aligned(1);

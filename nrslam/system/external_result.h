@@ -10,8 +10,11 @@
 // Estimates, either:
 //   - a CSV file with a header naming at least `frame`, `u`, `v` and `z`, and optionally
 //     `point_id`; other columns are ignored. A `z_est` column is taken for the depth before
-//     `z`, so a run's own points.csv scores to its own summary. Pixel coordinates are the image's (0,0 the centre of the top-left pixel), z any
-//     camera depth along the optical axis, in any unit: each frame's scale is fitted;
+//     `z`, so a run's own points.csv scores to its own summary. Pixel coordinates are the
+//     image's (0,0 the centre of the top-left pixel); those outside it are left out and
+//     counted, but more than a tenth outside, or all within two pixels (normalised
+//     coordinates), is refused. z is any camera depth along the optical axis, in any unit:
+//     each frame's scale is fitted;
 //   - a folder of single-channel depth images readable by OpenCV (16-bit PNG, float TIFF or
 //     EXR), one per frame, the frame number the last number in the file name. They are sampled
 //     every `depth_stride_px` pixels; 0, negative and non-finite values are "no estimate".
@@ -43,7 +46,8 @@ struct ExternalResult {
 nlohmann::json ToJson(const ExternalResult& result);
 
 // Throws Error for a bad sequence or bad estimates (a missing column, a row that is not
-// numbers, a frame outside the sequence, an image of the wrong size), naming the file and row.
+// numbers, a frame outside the sequence, pixels that cannot be the image's, an image of the
+// wrong size), naming the file and row.
 RunSummary ScoreExternalResult(const std::filesystem::path& sequence, const ExternalResult& result,
                                const EvaluationOptions& evaluation, const std::filesystem::path& out);
 

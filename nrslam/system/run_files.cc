@@ -61,6 +61,13 @@ std::string ViewJumpText(int view_jumps) {
          "of the scope; metrics.csv notes them)";
 }
 
+std::string OutsideImageText(int estimates_outside_image) {
+  if (estimates_outside_image == 0) return "";
+  return std::to_string(estimates_outside_image) +
+         (estimates_outside_image == 1 ? " estimate lay" : " estimates lay") +
+         " outside the image and were left out (u and v are the image's pixels, u across and v down)";
+}
+
 std::string StaticRegionText(double static_fraction) {
   if (static_fraction <= 0) return "";
   std::ostringstream text;
@@ -156,7 +163,7 @@ std::vector<std::string> InputEffects::Notes() const {
   for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
                            SparseGroundTruthText(frames_sparse_groundtruth), DropoutText(frames_dropout),
                            OcclusionText(sudden_occlusions), ViewJumpText(view_jumps),
-                           StaticRegionText(static_fraction)}) {
+                           StaticRegionText(static_fraction), OutsideImageText(estimates_outside_image)}) {
     if (!note.empty()) notes.push_back(std::move(note));
   }
   return notes;

@@ -51,16 +51,19 @@ struct InputEffects {
   // or a window of it (an on-screen display, an unmasked black border; system/static_regions.h,
   // margin included).
   double static_fraction = 0;
+  // Another system's estimates (nrslam_eval score) whose pixel lies outside the image: left out.
+  int estimates_outside_image = 0;
   // One note each, those that apply, in the order the runner and nrslam_eval print them:
   // unreadable files, sparse ground truth, image dropouts, sudden occlusions, jumps of the view,
-  // static regions.
+  // static regions, estimates outside the image.
   std::vector<std::string> Notes() const;
 };
 // Under the same flat keys in summary.json and in a results.json row; a key missing (results
 // written before it existed) reads as none.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InputEffects, frames_unreadable, frames_groundtruth_unreadable,
                                                 frames_unreadable_after_init, frames_sparse_groundtruth,
-                                                frames_dropout, sudden_occlusions, view_jumps, static_fraction)
+                                                frames_dropout, sudden_occlusions, view_jumps, static_fraction,
+                                                estimates_outside_image)
 
 // A change of a map's median depth beyond this factor, either way, gets a note: more than the
 // depth of an endoscopic scene changes over a sequence, less than a collapsing scale gives.
@@ -177,6 +180,10 @@ std::string ViewJumpText(int view_jumps);
 // "9.9 % of the image never changed (an on-screen display, a black border or background) and
 // was left out (static_mask.png)"; "" when none.
 std::string StaticRegionText(double static_fraction);
+
+// "3 estimates lay outside the image and were left out (u and v are the image's pixels, u
+// across and v down)", of another system's output; "" when none.
+std::string OutsideImageText(int estimates_outside_image);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked
