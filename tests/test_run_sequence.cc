@@ -473,6 +473,13 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
   EXPECT_NE(DescribeSummary(noted).find("1 estimate lay outside the image and were left out"), std::string::npos)
       << DescribeSummary(noted);
   EXPECT_EQ(ReadPointsCsv(*base_ / "scored_one_outside" / "points.csv").size(), 19u);
+  // A trajectory on a clock of its own (here the epoch's) is named as such.
+  std::ofstream(*base_ / "epoch.tum") << "1600000000.0 0 0 0 0 0 0 1\n";
+  one_outside.trajectory = *base_ / "epoch.tum";
+  const std::string clock = ErrorMessage(
+      [&] { ScoreExternalResult(*base_ / "sequence", one_outside, EvaluationOptions{}, *base_ / "scored_bad"); });
+  EXPECT_NE(clock.find("no frame of the sequence is at that time; times are frame / fps, 0 … "), std::string::npos)
+      << clock;
   ExternalResult images;
   images.estimates = *base_ / "wrong_size";
   fs::create_directories(images.estimates);

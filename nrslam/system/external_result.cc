@@ -185,7 +185,14 @@ std::map<int, Rigid3> ReadTrajectory(const fs::path& file, double fps, int frame
   for (const StampedPose& pose : ReadTum(file)) {
     const double frame = std::round(pose.timestamp * fps);
     const std::string where = file.string() + " (t = " + std::to_string(pose.timestamp) + " s)";
-    CheckFrame(frame, frame_count, where);
+    if (!(frame >= 0 && frame < frame_count)) {
+      // Most often a clock of its own (a recording's, the epoch's) instead of the frame's time.
+      std::ostringstream message;
+      message << where << ": no frame of the sequence is at that time; times are frame / fps, "
+              << std::fixed << std::setprecision(3) << "0 … " << (frame_count - 1) / fps << " s at " << std::defaultfloat << fps
+              << " fps (a trajectory on another clock needs its first frame's time subtracted)";
+      throw Error(message.str());
+    }
     if (!poses.emplace(static_cast<int>(frame), pose.world_from_camera).second) {
       throw Error(where + ": a second pose of frame " + std::to_string(static_cast<int>(frame)));
     }
