@@ -213,6 +213,22 @@ TEST(DepthEvaluation, OtherAlignmentsNeedTheFramesPairs) {
   EXPECT_EQ(EvaluateOtherAlignments({}, EvaluationOptions{}).frames_evaluated, 0);
 }
 
+// Depth at any scale correlates with the truth at +1; its inverse, over an endoscope's 10–60 mm,
+// at −0.89; an estimate that does not vary, not at all.
+TEST(DepthEvaluation, InverseDepthCorrelatesNegatively) {
+  std::vector<double> truth, scaled, inverse;
+  for (double z = 10; z <= 60; z += 2.5) {
+    truth.push_back(z);
+    scaled.push_back(0.03 * z);
+    inverse.push_back(1 / z);
+  }
+  EXPECT_NEAR(DepthCorrelation(scaled, truth), 1.0, 1e-12);
+  EXPECT_NEAR(DepthCorrelation(inverse, truth), -0.887543, 1e-6);  // numpy's corrcoef of the same
+  EXPECT_EQ(DepthCorrelation(std::vector<double>(truth.size(), 5.0), truth), 0.0);
+  EXPECT_EQ(DepthCorrelation({}, {}), 0.0);
+  EXPECT_THROW(DepthCorrelation({1, 2}, {1}), Error);
+}
+
 // Ground truth for the common-point tests: a slanted plane, 80 mm + 1 mm per column.
 cv::Mat SlantedPlaneDepth() {
   cv::Mat depth(40, 60, CV_32F);

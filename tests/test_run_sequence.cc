@@ -394,6 +394,21 @@ TEST_F(RunSequenceTest, ExternalDepthImagesScoreAsKnown) {
   // point is born.
   EXPECT_THROW(CompareRunFolders(*base_ / "run", scored), Error);
   EXPECT_EQ(summary.births.births_evaluated, 0);
+  EXPECT_EQ(summary.input.frames_depth_inverted, 0);
+  // Inverse depth, as a depth network writes disparity, is scored but named for what it is.
+  const fs::path inverse_images = *base_ / "inverse_depth";
+  fs::create_directories(inverse_images);
+  for (int frame = 0; frame < 10; ++frame) {
+    cv::Mat inverse;
+    cv::divide(1000.0, reader.ReadDepthMm(frame), inverse, CV_32F);  // 0 where the depth is 0
+    ASSERT_TRUE(cv::imwrite((inverse_images / (std::to_string(frame) + ".tiff")).string(), inverse));
+  }
+  external.estimates = inverse_images;
+  const RunSummary inverted = ScoreExternalResult(*base_ / "sequence", external, EvaluationOptions{}, scored);
+  EXPECT_EQ(inverted.frames_evaluated, 10);
+  EXPECT_EQ(inverted.input.frames_depth_inverted, 10);
+  EXPECT_NE(DescribeSummary(inverted).find("10 scored frames have estimates that fall as the true depth rises"),
+            std::string::npos) << DescribeSummary(inverted);
 }
 
 // An external result whose ids name points gets its births scored: the run's own points, plus

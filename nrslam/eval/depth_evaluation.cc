@@ -186,6 +186,23 @@ double MedianRatioScale(const std::vector<double>& estimated, const std::vector<
   return ratios.empty() ? 0.0 : Median(ratios);
 }
 
+double DepthCorrelation(const std::vector<double>& estimated, const std::vector<double>& groundtruth) {
+  if (estimated.size() != groundtruth.size()) throw Error("DepthCorrelation: as many estimates as true depths needed");
+  const double count = static_cast<double>(estimated.size());
+  if (count == 0) return 0.0;
+  const double mean_estimated = std::accumulate(estimated.begin(), estimated.end(), 0.0) / count;
+  const double mean_true = std::accumulate(groundtruth.begin(), groundtruth.end(), 0.0) / count;
+  double covariance = 0, variance_estimated = 0, variance_true = 0;
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    const double a = estimated[i] - mean_estimated, b = groundtruth[i] - mean_true;
+    covariance += a * b;
+    variance_estimated += a * a;
+    variance_true += b * b;
+  }
+  if (variance_estimated <= 0 || variance_true <= 0) return 0.0;
+  return covariance / std::sqrt(variance_estimated * variance_true);
+}
+
 OtherAlignments EvaluateOtherAlignments(const std::vector<FrameEvaluation>& frames, const EvaluationOptions& options) {
   std::map<int, std::pair<std::vector<double>, std::vector<double>>> pooled;  // per map: estimates, truths
   for (const FrameEvaluation& frame : frames) {

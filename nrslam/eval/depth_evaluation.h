@@ -84,6 +84,10 @@ SequenceMetrics AggregateFrames(const std::vector<FrameEvaluation>& frames);
 // median(z_gt / z_est) over the pairs whose estimate is in front of the camera; 0 without one.
 double MedianRatioScale(const std::vector<double>& estimated, const std::vector<double>& groundtruth);
 
+// Pearson's correlation of the estimates with the true depths: near 1 for depth at any scale,
+// strongly negative for inverse depth or disparity taken for depth; 0 when either is constant.
+double DepthCorrelation(const std::vector<double>& estimated, const std::vector<double>& groundtruth);
+
 // The evaluated frames (with their pairs) scored at other scales than their own, each frame's
 // RMSE trimmed as EvaluateDepthPairs trims, and averaged over the frames like rmse_mm:
 //   map scale:    one scale per map, fitted as a frame's is (trimmed least squares) to all of

@@ -358,6 +358,10 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     // Last used here, so its pairs move into the list kept for the alignments at the end.
     if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }
+  const auto inverted = std::count_if(evaluations.begin(), evaluations.end(), [](const FrameEvaluation& frame) {
+    return DepthCorrelation(frame.estimated, frame.groundtruth) < kInverseDepthCorrelation;
+  });
+  if (2 * inverted > static_cast<long>(evaluations.size())) summary.input.frames_depth_inverted = static_cast<int>(inverted);
   AggregateInto(&summary, evaluations, aligned, evaluation);
   summary.births = births.Summarise();
   summary.map_depth = depth_drift.Change();

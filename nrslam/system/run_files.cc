@@ -11,6 +11,7 @@
 #include "nrslam/util/median.h"
 #include "nrslam/util/source_revision.h"
 #include "nrslam/util/text_file.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 
@@ -66,6 +67,13 @@ std::string OutsideImageText(int estimates_outside_image) {
   return std::to_string(estimates_outside_image) +
          (estimates_outside_image == 1 ? " estimate lay" : " estimates lay") +
          " outside the image and were left out (u and v are the image's pixels, u across and v down)";
+}
+
+std::string InvertedDepthText(int frames_depth_inverted) {
+  if (frames_depth_inverted == 0) return "";
+  return std::to_string(frames_depth_inverted) + (frames_depth_inverted == 1 ? " scored frame has" : " scored frames have") +
+         " estimates that fall as the true depth rises (correlation below " + FormatFixed(kInverseDepthCorrelation, 1) +
+         "): inverse depth or disparity (as depth networks write) must be turned into depth first";
 }
 
 std::string StaticRegionText(double static_fraction) {
@@ -163,7 +171,8 @@ std::vector<std::string> InputEffects::Notes() const {
   for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
                            SparseGroundTruthText(frames_sparse_groundtruth), DropoutText(frames_dropout),
                            OcclusionText(sudden_occlusions), ViewJumpText(view_jumps),
-                           StaticRegionText(static_fraction), OutsideImageText(estimates_outside_image)}) {
+                           StaticRegionText(static_fraction), OutsideImageText(estimates_outside_image),
+                           InvertedDepthText(frames_depth_inverted)}) {
     if (!note.empty()) notes.push_back(std::move(note));
   }
   return notes;

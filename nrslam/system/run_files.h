@@ -53,9 +53,13 @@ struct InputEffects {
   double static_fraction = 0;
   // Another system's estimates (nrslam_eval score) whose pixel lies outside the image: left out.
   int estimates_outside_image = 0;
+  // Of another system's scored frames, those whose estimates fall as the true depth rises
+  // (DepthCorrelation below kInverseDepthCorrelation), recorded only when they are most of
+  // them: inverse depth or disparity taken for depth.
+  int frames_depth_inverted = 0;
   // One note each, those that apply, in the order the runner and nrslam_eval print them:
   // unreadable files, sparse ground truth, image dropouts, sudden occlusions, jumps of the view,
-  // static regions, estimates outside the image.
+  // static regions, estimates outside the image, inverted depth.
   std::vector<std::string> Notes() const;
 };
 // Under the same flat keys in summary.json and in a results.json row; a key missing (results
@@ -63,7 +67,7 @@ struct InputEffects {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InputEffects, frames_unreadable, frames_groundtruth_unreadable,
                                                 frames_unreadable_after_init, frames_sparse_groundtruth,
                                                 frames_dropout, sudden_occlusions, view_jumps, static_fraction,
-                                                estimates_outside_image)
+                                                estimates_outside_image, frames_depth_inverted)
 
 // A change of a map's median depth beyond this factor, either way, gets a note: more than the
 // depth of an endoscopic scene changes over a sequence, less than a collapsing scale gives.
@@ -184,6 +188,14 @@ std::string StaticRegionText(double static_fraction);
 // "3 estimates lay outside the image and were left out (u and v are the image's pixels, u
 // across and v down)", of another system's output; "" when none.
 std::string OutsideImageText(int estimates_outside_image);
+
+// A frame's estimates whose correlation with the true depth is below this fall as it rises;
+// depth at any scale correlates near +1, a poor estimate near 0.
+inline constexpr double kInverseDepthCorrelation = -0.5;
+
+// "57 scored frames have estimates that fall as the true depth rises: inverse depth or
+// disparity (as depth networks write) must be turned into depth first"; "" when none.
+std::string InvertedDepthText(int frames_depth_inverted);
 
 // The summary's figures: the depth aggregates of the evaluated frames (each with its pairs and
 // map, as EvaluateFrame and the caller left them) and the trajectory error of the tracked
