@@ -457,6 +457,12 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
   EXPECT_NE(error_of("frame,u,v,z\n0,1,2,3\n0,1,x,3\n").find("bad.csv:3: 'x' (v) is not a number"), std::string::npos);
   EXPECT_NE(error_of("frame,u,v,z\n40,1,2,3\n").find("frame 40 is not a frame of the sequence"), std::string::npos);
   EXPECT_NE(error_of("frame,u,v,z\n0,1,2\n").find("3 fields, the header needs 4"), std::string::npos);
+  EXPECT_NE(error_of("frame,point_id,u,v,z\n0,2.5,1,2,3\n").find("bad.csv:2: '2.5' (point_id) is not a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of("frame,point_id,u,v,z\n0,nan,1,2,3\n").find("'nan' (point_id) is not a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of("frame,point_id,u,v,z\n0,7,1,2,3\n1,7,1,2,3\n1,7,5,2,3\n").find("bad.csv:4: point_id 7 a second time in frame 1"),
+            std::string::npos);
   // An estimate a system failed to make (NaN, 0) is no estimate, not a broken file.
   EXPECT_EQ(error_of("frame,u,v,z\n0,10,20,nan\n1,10,20,0\n"), "no error");
   // Files as other programs write them: spaces after the commas, a spreadsheet's quoted header

@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -112,6 +113,7 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, const cv::Si
   const size_t needed = std::max({frame_column, u_column, v_column, z_column, id_column}) + 1;
   FrameEstimates estimates;
   std::vector<cv::Point2d> pixels;
+  std::set<std::pair<int, int64_t>> ids_seen;  // frame, point_id
   *outside = 0;
   while (ReadCsvRecord(in, file.string(), &line, &fields)) {
     const std::string where = file.string() + ":" + std::to_string(line);
@@ -127,7 +129,22 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, const cv::Si
     CheckFrame(frame, frame_count, where);
     std::vector<EstimatedPoint>& points = estimates[static_cast<int>(frame)];
     const double u = number(u_column), v = number(v_column), z = number(z_column);
-    const auto id = has_ids ? static_cast<int64_t>(number(id_column)) : static_cast<int64_t>(points.size());
+    int64_t id = static_cast<int64_t>(points.size());
+    if (has_ids) {
+      // Whole and within the integers a double holds exactly: a fraction or NaN cast to an id
+      // would merge points that are not one, or give every NaN row the same id.
+      const double value = number(id_column);
+      if (!(std::abs(value) <= 9007199254740992.0 && value == std::floor(value))) {
+        throw Error(where + ": '" + fields[id_column] + "' (point_id) is not a whole number");
+      }
+      id = static_cast<int64_t>(value);
+      // One point is at one place in a frame; two rows of it would be paired with another
+      // run's point twice, or its birth scored twice.
+      if (!ids_seen.emplace(static_cast<int>(frame), id).second) {
+        throw Error(where + ": point_id " + std::to_string(id) + " a second time in frame " +
+                    std::to_string(static_cast<int>(frame)));
+      }
+    }
     if (!(std::isfinite(u) && std::isfinite(v) && std::isfinite(z) && z > 0)) continue;
     pixels.emplace_back(u, v);
     if (u < -0.5 || v < -0.5 || u > size.width - 0.5 || v > size.height - 0.5) {
