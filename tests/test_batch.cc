@@ -1703,6 +1703,16 @@ TEST(Tools, PreviewOfADamagedSequenceSkipsOnlyTheDamagedFrames) {
       RunCaught(preview + " --frame 2 --out " + (folder / "one.png").string(), folder / "one.txt");
   EXPECT_NE(single, 0);
   EXPECT_NE(single_log.find("cannot decode"), std::string::npos) << single_log;
+  // A folder that --out names but that does not exist yet is made; a name OpenCV cannot write
+  // an image to is refused before anything is drawn, naming it.
+  const auto [nested, nested_log] =
+      RunCaught(preview + " --frame 1 --out " + (folder / "new" / "one.png").string(), folder / "nested.txt");
+  EXPECT_EQ(nested, 0) << nested_log;
+  EXPECT_TRUE(std::filesystem::exists(folder / "new" / "one.png"));
+  const auto [bare, bare_log] = RunCaught(preview + " --frame 1 --out " + (folder / "one").string(), folder / "bare.txt");
+  EXPECT_NE(bare, 0);
+  EXPECT_NE(bare_log.find("--out " + (folder / "one").string() + ": not an image file name OpenCV writes"),
+            std::string::npos) << bare_log;
   std::filesystem::remove_all(folder);
 }
 

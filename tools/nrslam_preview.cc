@@ -203,13 +203,19 @@ int main(int argc, char** argv) {
   try {
     view_options.Check();
     if (!(scale > 0)) throw nrslam::Error("--scale must be > 0");
+    const bool to_video = fs::path(out).extension() == ".avi";
+    // Checked before anything is drawn: OpenCV's own message names neither the file nor a fix.
+    if (!all_frames && !cv::haveImageWriter(out)) {
+      throw nrslam::Error("--out " + out + ": not an image file name OpenCV writes (e.g. view.png; with --all, a "
+                          "folder or a .avi video)");
+    }
+    if (!all_frames || to_video) nrslam::CreateFolder(fs::absolute(out).parent_path());
     const Preview preview(sequence, runs, view_options, scale);
     if (!all_frames) {
       WritePng(out, preview.Draw(frame));
       return 0;
     }
     int skipped = 0;  // frames whose colour image could not be read
-    const bool to_video = fs::path(out).extension() == ".avi";
     if (to_video) {
       // Motion JPEG: OpenCV writes it without any external codec.
       // A skipped frame is a black one, so the video keeps the sequence's timing; those before
