@@ -1709,7 +1709,8 @@ TEST(Tools, PreviewOfADamagedSequenceSkipsOnlyTheDamagedFrames) {
       RunCaught(preview + " --frame 1 --out " + (folder / "new" / "one.png").string(), folder / "nested.txt");
   EXPECT_EQ(nested, 0) << nested_log;
   EXPECT_TRUE(std::filesystem::exists(folder / "new" / "one.png"));
-  const auto [bare, bare_log] = RunCaught(preview + " --frame 1 --out " + (folder / "one").string(), folder / "bare.txt");
+  const auto [bare, bare_log] =
+      RunCaught(preview + " --frame 1 --out " + (folder / "one").string(), folder / "bare.txt");
   EXPECT_NE(bare, 0);
   EXPECT_NE(bare_log.find("--out " + (folder / "one").string() + ": not an image file name OpenCV writes"),
             std::string::npos) << bare_log;

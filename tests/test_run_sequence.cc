@@ -461,7 +461,8 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
             std::string::npos);
   EXPECT_NE(error_of("frame,point_id,u,v,z\n0,nan,1,2,3\n").find("'nan' (point_id) is not a whole number"),
             std::string::npos);
-  EXPECT_NE(error_of("frame,point_id,u,v,z\n0,7,1,2,3\n1,7,1,2,3\n1,7,5,2,3\n").find("bad.csv:4: point_id 7 a second time in frame 1"),
+  EXPECT_NE(error_of("frame,point_id,u,v,z\n0,7,1,2,3\n1,7,1,2,3\n1,7,5,2,3\n")
+                .find("bad.csv:4: point_id 7 a second time in frame 1"),
             std::string::npos);
   // An estimate a system failed to make (NaN, 0) is no estimate, not a broken file.
   EXPECT_EQ(error_of("frame,u,v,z\n0,10,20,nan\n1,10,20,0\n"), "no error");
@@ -491,7 +492,7 @@ TEST_F(RunSequenceTest, BadExternalResultsGiveOneClearError) {
   const RunSummary noted =
       ScoreExternalResult(*base_ / "sequence", one_outside, EvaluationOptions{}, *base_ / "scored_one_outside");
   EXPECT_EQ(noted.input.estimates_outside_image, 1);
-  EXPECT_NE(DescribeSummary(noted).find("1 estimate lay outside the image and were left out"), std::string::npos)
+  EXPECT_NE(DescribeSummary(noted).find("1 estimate lay outside the image and was left out"), std::string::npos)
       << DescribeSummary(noted);
   EXPECT_EQ(ReadPointsCsv(*base_ / "scored_one_outside" / "points.csv").size(), 19u);
   // A trajectory on a clock of its own (here the epoch's) is named as such.

@@ -67,7 +67,8 @@ void CheckPixelsAreTheImages(const fs::path& file, const std::vector<cv::Point2d
     high = {std::max(high.x, pixel.x), std::max(high.y, pixel.y)};
   }
   std::ostringstream where;
-  where << std::fixed << std::setprecision(1) << "u " << low.x << " … " << high.x << ", v " << low.y << " … " << high.y;
+  where << std::fixed << std::setprecision(1) << "u " << low.x << " … " << high.x << ", v " << low.y << " … "
+        << high.y;
   const std::string expected = "u and v are expected in the image's pixels, u across and v down, (0,0) the centre "
                                "of the top-left pixel";
   const std::string count = std::to_string(pixels.size());
@@ -205,8 +206,8 @@ std::map<int, Rigid3> ReadTrajectory(const fs::path& file, double fps, int frame
     if (!(frame >= 0 && frame < frame_count)) {
       // Most often a clock of its own (a recording's, the epoch's) instead of the frame's time.
       std::ostringstream message;
-      message << where << ": no frame of the sequence is at that time; times are frame / fps, "
-              << std::fixed << std::setprecision(3) << "0 … " << (frame_count - 1) / fps << " s at " << std::defaultfloat << fps
+      message << where << ": no frame of the sequence is at that time; times are frame / fps, " << std::fixed
+              << std::setprecision(3) << "0 … " << (frame_count - 1) / fps << " s at " << std::defaultfloat << fps
               << " fps (a trajectory on another clock needs its first frame's time subtracted)";
       throw Error(message.str());
     }
@@ -378,7 +379,9 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   const auto inverted = std::count_if(evaluations.begin(), evaluations.end(), [](const FrameEvaluation& frame) {
     return DepthCorrelation(frame.estimated, frame.groundtruth) < kInverseDepthCorrelation;
   });
-  if (2 * inverted > static_cast<long>(evaluations.size())) summary.input.frames_depth_inverted = static_cast<int>(inverted);
+  if (2 * static_cast<size_t>(inverted) > evaluations.size()) {
+    summary.input.frames_depth_inverted = static_cast<int>(inverted);
+  }
   AggregateInto(&summary, evaluations, aligned, evaluation);
   summary.births = births.Summarise();
   summary.map_depth = depth_drift.Change();

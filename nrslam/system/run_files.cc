@@ -65,14 +65,17 @@ std::string ViewJumpText(int view_jumps) {
 std::string OutsideImageText(int estimates_outside_image) {
   if (estimates_outside_image == 0) return "";
   return std::to_string(estimates_outside_image) +
-         (estimates_outside_image == 1 ? " estimate lay" : " estimates lay") +
-         " outside the image and were left out (u and v are the image's pixels, u across and v down)";
+         (estimates_outside_image == 1 ? " estimate lay outside the image and was"
+                                       : " estimates lay outside the image and were") +
+         " left out (u and v are the image's pixels, u across and v down)";
 }
 
 std::string InvertedDepthText(int frames_depth_inverted) {
   if (frames_depth_inverted == 0) return "";
-  return std::to_string(frames_depth_inverted) + (frames_depth_inverted == 1 ? " scored frame has" : " scored frames have") +
-         " estimates that fall as the true depth rises (correlation below " + FormatFixed(kInverseDepthCorrelation, 1) +
+  return std::to_string(frames_depth_inverted) +
+         (frames_depth_inverted == 1 ? " scored frame has" : " scored frames have") +
+         " estimates that fall as the true depth rises (correlation below " +
+         FormatFixed(kInverseDepthCorrelation, 1) +
          "): inverse depth or disparity (as depth networks write) must be turned into depth first";
 }
 
