@@ -206,8 +206,10 @@ std::string DescribeSummary(const RunSummary& summary) {
   text << "frames tracked " << summary.frames_tracked << "/" << summary.frames_total << " (init at " << summary.init_frame
        << ", lost " << summary.frames_lost << ")  ";
   if (summary.frames_evaluated > 0) {
-    text << "RMSE mean " << summary.rmse_mm << " mm, median " << summary.rmse_median_mm << " mm (flat map "
-         << summary.rmse_flat_mm << " mm; one scale per map " << summary.rmse_map_scale_mm << " mm)  ";
+    // Rounded as the results table rounds them; summary.json keeps every digit.
+    text << "RMSE mean " << FormatFixed(summary.rmse_mm, 3) << " mm, median " << FormatFixed(summary.rmse_median_mm, 3)
+         << " mm (flat map " << FormatFixed(summary.rmse_flat_mm, 3) << " mm; one scale per map "
+         << FormatFixed(summary.rmse_map_scale_mm, 3) << " mm)  ";
   } else if (summary.frames_tracked == 0) {
     text << "no frame tracked, no RMSE  ";
   } else if (summary.input.frames_sparse_groundtruth > 0) {
@@ -215,12 +217,14 @@ std::string DescribeSummary(const RunSummary& summary) {
   } else {
     text << "no ground truth, no RMSE  ";
   }
-  if (summary.trajectory_error.evaluated) text << "trajectory error " << summary.trajectory_error.rmse_mm << " mm  ";
-  if (summary.births.mean) {
-    text << "new points born at log depth error " << *summary.births.mean << " (median " << *summary.births.median
-         << ", " << summary.births.births_evaluated << " points)  ";
+  if (summary.trajectory_error.evaluated) {
+    text << "trajectory error " << FormatFixed(summary.trajectory_error.rmse_mm, 3) << " mm  ";
   }
-  if (summary.fps > 0) text << summary.fps << " fps";
+  if (summary.births.mean) {
+    text << "new points born at log depth error " << FormatFixed(*summary.births.mean, 3) << " (median "
+         << FormatFixed(*summary.births.median, 3) << ", " << summary.births.births_evaluated << " points)  ";
+  }
+  if (summary.fps > 0) text << FormatFixed(summary.fps, 1) << " fps";
   if (summary.peak_memory_mb > 0) text << "  peak memory " << std::lround(summary.peak_memory_mb) << " MB";
   const std::string stop = DescribeStop(summary.init_frame, summary.stop_frame, summary.stop_reason);
   if (!stop.empty()) text << '\n' << stop;
