@@ -191,6 +191,13 @@ TEST(DatasetImport, HamlynIntrinsicsAsThreeByThreeThreeByFourOrFourByFour) {
   const SequenceReader homogeneous = import_with("  50.5 0 31.2 0\r\n\n0 50.7 23.9 0\r\n0 0 1 0\r\n0 0 0 1\r\n");
   EXPECT_EQ(homogeneous.info().camera.params(), Camera::Pinhole(kWidth, kHeight, 50.5, 50.7, 31.2, 23.9).params());
   EXPECT_FALSE(homogeneous.has_right());  // no baseline: the right images cannot be used
+  // A rectified right camera's projection matrix gives the baseline: its 4th column, fx·(−B).
+  const SequenceReader right_projection = import_with("50.5 0 31.2 -271.69\n0 50.7 23.9 0\n0 0 1 0\n");
+  EXPECT_EQ(right_projection.info().camera.params(), Camera::Pinhole(kWidth, kHeight, 50.5, 50.7, 31.2, 23.9).params());
+  ASSERT_TRUE(right_projection.has_right());
+  EXPECT_NEAR(right_projection.info().stereo->baseline_mm, 5.38, 1e-12);
+  EXPECT_DOUBLE_EQ(import_with("50.5 0 31.2 -271.69\n0 50.7 23.9 0\n0 0 1 0\n5.4\n").info().stereo->baseline_mm,
+                   5.4);  // within 1 %: the line's
 
   const auto error_with = [&](const std::string& intrinsics) {
     std::ofstream(in / "intrinsics.txt") << intrinsics;
@@ -202,6 +209,11 @@ TEST(DatasetImport, HamlynIntrinsicsAsThreeByThreeThreeByFourOrFourByFour) {
   EXPECT_NE(error_with("fx 0 cx\n0 fy cy\n0 0 1\n").find("intrinsics.txt line 1 is not a row of numbers"),
             std::string::npos);
   EXPECT_NE(error_with("50.5 0 31.2\n0 50.7 23.9\n0 0 1\n5.38 1\n").find("the 4th line holds 2 numbers"),
+            std::string::npos);
+  EXPECT_NE(error_with("50.5 0 31.2 -271.69\n0 50.7 23.9 0\n0 0 1 0\n6\n")
+                .find("the baseline after K (6.000 mm) is not the one its projection matrix gives (5.380 mm"),
+            std::string::npos);
+  EXPECT_NE(error_with("50.5 0 31.2 0\n0 50.7 23.9 -271.69\n0 0 1 0\n").find("a 4th column other than 0 0 0"),
             std::string::npos);
 
   // --stereo-depth without a baseline says what is missing, not that the right images are.

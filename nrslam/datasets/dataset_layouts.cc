@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "nrslam/io/sequence_info.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam::importer {
 namespace fs = std::filesystem;
@@ -21,10 +22,11 @@ struct HamlynIntrinsics {
   double baseline_mm = 0;  // 0: not given
 };
 
-// K as three rows of 3 numbers, or of 4 (a 3×4 projection matrix, whose last column says
-// nothing of K), or four rows of 4 (a homogeneous 4×4, last row 0 0 0 1); then, optionally,
-// one line holding the baseline in mm. Read by rows: taken as one list of numbers, a 3×4 put
-// 0 where fy is.
+// K as three rows of 3 numbers, or of 4 (a 3×4 projection matrix), or four rows of 4 (a
+// homogeneous 4×4, last row 0 0 0 1); then, optionally, one line holding the baseline in mm.
+// Read by rows: taken as one list of numbers, a 3×4 put 0 where fy is. A rectified right
+// camera's projection matrix (OpenCV's stereoRectify P2) has fx·(−B) atop its last column:
+// the baseline (in the calibration's unit, mm for Hamlyn), when no line gives it.
 HamlynIntrinsics ReadHamlynIntrinsics(const ImportOptions& options) {
   std::vector<std::vector<double>> rows;
   for (const NumberLine& line : NumberLines(options, "intrinsics.txt")) {
@@ -44,15 +46,27 @@ HamlynIntrinsics ReadHamlynIntrinsics(const ImportOptions& options) {
     Fail(options, expected + " (a skew or a last row other than 0 0 1 is not a pinhole K)");
   }
   HamlynIntrinsics intrinsics{rows[0][0], rows[1][1], rows[0][2], rows[1][2]};
+  const auto translation = [&](int r) { return rows[r].size() == 4 ? rows[r][3] : 0.0; };
+  if (translation(1) != 0 || translation(2) != 0) {
+    Fail(options, expected + " (a 4th column other than 0 0 0 or that of a rectified right camera, fx·(-B) 0 0)");
+  }
+  const double projected_baseline_mm = std::abs(translation(0) / intrinsics.fx);
   if (rows.size() == 4) {
     const std::vector<double>& last = rows[3];
     if (last.size() == 1) {
       if (last[0] == 0) Fail(options, "intrinsics.txt: the baseline (after K) is 0 mm");
       intrinsics.baseline_mm = std::abs(last[0]);
+      const double disagreement = std::abs(projected_baseline_mm - intrinsics.baseline_mm);
+      if (projected_baseline_mm > 0 && disagreement > 0.01 * intrinsics.baseline_mm) {
+        Fail(options, "intrinsics.txt: the baseline after K (" + FormatFixed(intrinsics.baseline_mm, 3) +
+                          " mm) is not the one its projection matrix gives (" + FormatFixed(projected_baseline_mm, 3) +
+                          " mm, its 4th column over fx)");
+      }
     } else if (last != std::vector<double>{0, 0, 0, 1}) {
       Fail(options, expected + " (the 4th line holds " + std::to_string(last.size()) + " numbers)");
     }
   }
+  if (intrinsics.baseline_mm == 0) intrinsics.baseline_mm = projected_baseline_mm;
   return intrinsics;
 }
 
