@@ -120,21 +120,20 @@ CacheContents ReadCacheContents(const std::filesystem::path& cache) {
   for (const auto& entry : std::filesystem::directory_iterator(cache)) entries.push_back(entry.path());
   std::sort(entries.begin(), entries.end());
   CacheContents contents;
-  std::set<std::filesystem::path> logs;  // of the sequences: each is counted with its sequence
+  std::set<std::filesystem::path> of_sequences;  // their folders and logs
   for (const std::filesystem::path& entry : entries) {
     const std::filesystem::path sequence_json = entry / "sequence.json";
+    // stat, not std::filesystem: C++17 has no way from a file's time to the calendar's.
     struct stat status {};
     if (IsCacheName(entry.filename().string()) && std::filesystem::is_directory(entry) &&
         ::stat(sequence_json.c_str(), &status) == 0 && S_ISREG(status.st_mode)) {
       contents.sequences.push_back({entry, RecordedCode(sequence_json), BytesUnder(entry) + BytesUnder(LogOf(entry)),
                                     status.st_mtime});
-      logs.insert(LogOf(entry));
+      of_sequences.insert({entry, LogOf(entry)});
     }
   }
   for (const std::filesystem::path& entry : entries) {
-    const bool sequence = std::any_of(contents.sequences.begin(), contents.sequences.end(),
-                                      [&](const CachedSequence& s) { return s.folder == entry; });
-    if (!sequence && logs.count(entry) == 0) contents.others.push_back(entry);
+    if (of_sequences.count(entry) == 0) contents.others.push_back(entry);
   }
   return contents;
 }

@@ -50,7 +50,9 @@ HamlynIntrinsics ReadHamlynIntrinsics(const ImportOptions& options) {
   if (translation(1) != 0 || translation(2) != 0) {
     Fail(options, expected + " (a 4th column other than 0 0 0 or that of a rectified right camera, fx·(-B) 0 0)");
   }
-  const double projected_baseline_mm = std::abs(translation(0) / intrinsics.fx);
+  // fx ≤ 0 is refused with the camera, after this.
+  const double projected_baseline_mm =
+      translation(0) != 0 && intrinsics.fx > 0 ? std::abs(translation(0) / intrinsics.fx) : 0.0;
   if (rows.size() == 4) {
     const std::vector<double>& last = rows[3];
     if (last.size() == 1) {
