@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 #include <utility>
 
 #include "nrslam/util/error.h"
@@ -188,10 +187,8 @@ double MedianRatioScale(const std::vector<double>& estimated, const std::vector<
 
 double DepthCorrelation(const std::vector<double>& estimated, const std::vector<double>& groundtruth) {
   if (estimated.size() != groundtruth.size()) throw Error("DepthCorrelation: as many estimates as true depths needed");
-  const double count = static_cast<double>(estimated.size());
-  if (count == 0) return 0.0;
-  const double mean_estimated = std::accumulate(estimated.begin(), estimated.end(), 0.0) / count;
-  const double mean_true = std::accumulate(groundtruth.begin(), groundtruth.end(), 0.0) / count;
+  if (estimated.empty()) return 0.0;
+  const double mean_estimated = Mean(estimated), mean_true = Mean(groundtruth);
   double covariance = 0, variance_estimated = 0, variance_true = 0;
   for (size_t i = 0; i < estimated.size(); ++i) {
     const double a = estimated[i] - mean_estimated, b = groundtruth[i] - mean_true;
