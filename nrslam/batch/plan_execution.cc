@@ -156,7 +156,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
     if (std::filesystem::exists(prepare.folder)) continue;
     CreateFolder(prepare.folder.parent_path());
     const std::filesystem::path partial = PartialFolder(prepare.folder);
-    Command command{PrepareCommand(prepare, programs), partial.string() + ".log"};
+    Command command{PrepareCommand(prepare, programs), CacheLog(partial)};
     command.argv.insert(command.argv.end(), {"--out", partial.string()});
     prepares.push_back(command);
     prepare_index.push_back(i);
@@ -172,7 +172,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
     // Another evaluation that prepared the same sequence first made the same files.
     const bool ready = outcome.ok() && (!not_moved || std::filesystem::exists(prepare.folder));
     std::error_code ignored;
-    std::filesystem::rename(prepares[k].log, prepare.folder.string() + ".log", ignored);
+    std::filesystem::rename(prepares[k].log, CacheLog(prepare.folder), ignored);
     std::filesystem::remove_all(partial, ignored);
     if (outcome.interrupted) return;
     const std::string verb = prepare.import ? "imported " : "rendered ";

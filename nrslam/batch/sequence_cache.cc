@@ -44,8 +44,6 @@ std::string HostName() {
   return host;
 }
 
-std::filesystem::path LogOf(const std::filesystem::path& folder) { return folder.string() + ".log"; }
-
 std::uintmax_t BytesUnder(const std::filesystem::path& path) {
   std::error_code unreadable;
   if (std::filesystem::is_regular_file(path, unreadable)) return std::filesystem::file_size(path, unreadable);
@@ -87,6 +85,8 @@ std::filesystem::path CachedSequenceFolder(const std::filesystem::path& cache, c
   return cache / (stem + "-" + StableHash(key));
 }
 
+std::filesystem::path CacheLog(const std::filesystem::path& folder) { return folder.string() + ".log"; }
+
 std::filesystem::path PartialFolder(const std::filesystem::path& folder) {
   static std::atomic<int> count{0};
   return folder.string() + ".partial." + HostName() + "-" + std::to_string(::getpid()) + "-" +
@@ -127,9 +127,9 @@ CacheContents ReadCacheContents(const std::filesystem::path& cache) {
     struct stat status {};
     if (IsCacheName(entry.filename().string()) && std::filesystem::is_directory(entry) &&
         ::stat(sequence_json.c_str(), &status) == 0 && S_ISREG(status.st_mode)) {
-      contents.sequences.push_back({entry, RecordedCode(sequence_json), BytesUnder(entry) + BytesUnder(LogOf(entry)),
+      contents.sequences.push_back({entry, RecordedCode(sequence_json), BytesUnder(entry) + BytesUnder(CacheLog(entry)),
                                     status.st_mtime});
-      of_sequences.insert({entry, LogOf(entry)});
+      of_sequences.insert({entry, CacheLog(entry)});
     }
   }
   for (const std::filesystem::path& entry : entries) {
@@ -178,7 +178,7 @@ CachePruning RemoveSequencesOfOtherCode(const std::filesystem::path& cache, cons
     if (sequence.MadeByThisCode()) continue;
     std::error_code failed;
     std::filesystem::remove_all(sequence.folder, failed);
-    if (!failed) std::filesystem::remove(LogOf(sequence.folder), failed);
+    if (!failed) std::filesystem::remove(CacheLog(sequence.folder), failed);
     if (failed) {
       pruning.failures.push_back(sequence.folder.string() + ": " + failed.message());
     } else {

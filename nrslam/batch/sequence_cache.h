@@ -23,6 +23,10 @@ std::filesystem::path CachedSequenceFolder(const std::filesystem::path& cache, c
 // a folder of its own.
 std::filesystem::path PartialFolder(const std::filesystem::path& folder);
 
+// The log beside a folder of the cache, finished or partial: <folder>.log. It goes with its
+// sequence (ReadCacheContents, RemoveSequencesOfOtherCode).
+std::filesystem::path CacheLog(const std::filesystem::path& folder);
+
 // Removes the partial folders (and their logs) in `cache` that interrupted evaluations on this
 // machine left behind: those whose process is gone. A cache shared between machines keeps the
 // others'.

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "nrslam/camera/camera.h"
 #include "nrslam/io/sequence_info.h"
 #include "nrslam/io/sequence_reader.h"
 #include "nrslam/io/tum.h"
@@ -59,7 +60,7 @@ void CheckFrame(double frame, int frame_count, const std::string& where) {
 // ground truth, or none, without a word. A few outside (a system that reports points leaving
 // the view) are left out and counted.
 void CheckPixelsAreTheImages(const fs::path& file, const std::vector<cv::Point2d>& pixels, int outside,
-                             const cv::Size& size) {
+                             const Camera& camera) {
   if (pixels.empty()) return;
   cv::Point2d low = pixels.front(), high = pixels.front();
   for (const cv::Point2d& pixel : pixels) {
@@ -74,8 +75,8 @@ void CheckPixelsAreTheImages(const fs::path& file, const std::vector<cv::Point2d
   const std::string count = std::to_string(pixels.size());
   if (10 * static_cast<size_t>(outside) > pixels.size()) {
     throw Error(file.string() + ": " + std::to_string(outside) + " of its " + count + " estimates lie outside the " +
-                std::to_string(size.width) + "x" + std::to_string(size.height) + " image (" + where.str() + "): " +
-                expected);
+                std::to_string(camera.width()) + "x" + std::to_string(camera.height()) + " image (" + where.str() +
+                "): " + expected);
   }
   constexpr size_t kFewestToJudgeSpread = 10;
   if (pixels.size() >= kFewestToJudgeSpread && high.x - low.x < 2 && high.y - low.y < 2) {
@@ -86,7 +87,7 @@ void CheckPixelsAreTheImages(const fs::path& file, const std::vector<cv::Point2d
 
 // `has_point_ids`: whether the file has its own point_id column (else ids number rows).
 // `outside`: the estimates left out because their pixel lies outside the image.
-FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, const cv::Size& size, bool* has_point_ids,
+FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, const Camera& camera, bool* has_point_ids,
                              int* outside) {
   std::ifstream in = OpenToRead(file, "CSV file");
   int line = 0;
@@ -148,13 +149,13 @@ FrameEstimates ReadPointsCsv(const fs::path& file, int frame_count, const cv::Si
     }
     if (!(std::isfinite(u) && std::isfinite(v) && std::isfinite(z) && z > 0)) continue;
     pixels.emplace_back(u, v);
-    if (u < -0.5 || v < -0.5 || u > size.width - 0.5 || v > size.height - 0.5) {
+    if (!camera.InImage(Eigen::Vector2d(u, v), /*margin=*/-0.5)) {  // pixels' outer edges, not centres
       ++*outside;
     } else {
       points.push_back({id, {u, v}, z});
     }
   }
-  CheckPixelsAreTheImages(file, pixels, *outside, size);
+  CheckPixelsAreTheImages(file, pixels, *outside, camera);
   return estimates;
 }
 
@@ -276,7 +277,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
   const FrameEstimates estimates =
       fs::is_directory(result.estimates)
           ? ReadDepthImages(result.estimates, size, result.depth_stride_px, reader.frame_count())
-          : ReadPointsCsv(result.estimates, reader.frame_count(), size, &ids_name_points, &outside_image);
+          : ReadPointsCsv(result.estimates, reader.frame_count(), info.camera, &ids_name_points, &outside_image);
   const std::map<int, Rigid3> poses =
       result.trajectory.empty() ? std::map<int, Rigid3>{} : ReadTrajectory(result.trajectory, info.fps, reader.frame_count());
 
