@@ -177,6 +177,36 @@ TEST_F(KltOnWarps, FlatAndNoiseFramesConfirmNoTrack) {
   EXPECT_EQ(tracked_into(*reference_, gated), static_cast<long>(points_->size()));
 }
 
+// The reference resized its patch storage at a new reference instead of clearing it, so a
+// point that got no new patch (under the mask) kept the old reference's (reference-behaviour
+// §4.1, §9.2). The same points again with the left half masked: those there have no patch.
+TEST_F(KltOnWarps, ANewReferenceKeepsNoPatchOfTheOldOne) {
+  const ImagePyramid pyramid(*reference_, 5);
+  KltTracker tracker{KltOptions{}};
+  tracker.SetReference(pyramid, *points_);
+  cv::Mat valid(reference_->size(), CV_8UC1, cv::Scalar(255));
+  const int half_width = reference_->cols / 2;
+  valid.colRange(0, half_width).setTo(0);
+  tracker.SetReference(pyramid, *points_, valid);
+  std::vector<KltResult> results;
+  tracker.Track(pyramid, *points_, 0.75, &results);
+  // A level-0 window (21 px) wholly under the mask, or every level's (21 px at 1/16) clear of it.
+  int masked = 0, clear = 0;
+  for (size_t i = 0; i < points_->size(); ++i) {
+    const float x = (*points_)[i].x;
+    if (x < half_width - 11) {
+      ++masked;
+      EXPECT_FALSE(tracker.has_reference(i)) << "point " << i << " at x = " << x;
+      EXPECT_EQ(results[i].status, KltStatus::kNoReference) << "point " << i << " at x = " << x;
+    } else if (x > half_width + 11 * 16) {
+      ++clear;
+      EXPECT_TRUE(tracker.has_reference(i)) << "point " << i << " at x = " << x;
+    }
+  }
+  EXPECT_GT(masked, 50);
+  EXPECT_GT(clear, 20);
+}
+
 TEST(Klt, RejectsBadInputCleanly) {
   const cv::Mat flat(120, 160, CV_8UC1, cv::Scalar(90));
   KltTracker tracker{KltOptions{}};

@@ -11,6 +11,17 @@
 namespace nrslam {
 namespace {
 
+// Frames are read in OpenCV's BGR order. The reference converted them with RGB weights
+// (reference-behaviour §9.2), which weighs red as blue and blue as red.
+TEST(Grey, WeighsTheChannelsOfABgrFrameAsTheirColoursNeed) {
+  const cv::Mat blue(1, 1, CV_8UC3, cv::Scalar(255, 0, 0));
+  const cv::Mat green(1, 1, CV_8UC3, cv::Scalar(0, 255, 0));
+  const cv::Mat red(1, 1, CV_8UC3, cv::Scalar(0, 0, 255));
+  EXPECT_EQ(ToGrey(blue).at<uint8_t>(0, 0), 29);    // 0.114 × 255
+  EXPECT_EQ(ToGrey(green).at<uint8_t>(0, 0), 150);  // 0.587 × 255
+  EXPECT_EQ(ToGrey(red).at<uint8_t>(0, 0), 76);     // 0.299 × 255
+}
+
 TEST(Masks, CombinesBorderHighlightsAndTheSequenceMaskThenErodes) {
   cv::Mat grey(100, 120, CV_8UC1, cv::Scalar(100));
   grey.at<uint8_t>(50, 60) = 250;  // a specular highlight

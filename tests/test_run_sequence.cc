@@ -20,6 +20,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "camera_fixtures.h"
 #include "error_message.h"
@@ -790,6 +791,13 @@ struct MonocularOutcome {
   // by more than a factor of 2.
   double new_point_log_depth_error = 0;
   double new_point_gross_error_fraction = 0;
+  // The first two tracked frames (reference-behaviour §9.2's keyframe-queue bug reset both to
+  // the reference view): per frame, the median distance of the points' pixels from their
+  // world positions projected through the frame's own pose, and through the reference view's.
+  std::vector<double> first_frames_reprojection_px, first_frames_offset_from_reference_px;
+  // Points reported twice in a frame: the same id, or two ids at one pixel (one track feeding
+  // two map points, §9.2's re-triangulated track).
+  int repeated_points = 0;
 };
 
 // log(s·z / true depth) of each new point on the frame it was first tracked, recomputed from
@@ -814,6 +822,35 @@ std::vector<double> NewPointLogDepthErrors(const std::vector<CsvPoint>& points, 
 }
 
 
+// Fills the outcome's pixel checks of a monocular run with one map, whose world frame is the
+// reference camera's.
+void FirstTrackedFrames(const std::vector<CsvPoint>& points, const fs::path& folder, int init_frame,
+                        MonocularOutcome* outcome) {
+  const SequenceReader sequence(folder / "sequence");
+  const Camera& camera = sequence.info().camera;
+  std::map<int, Rigid3> cam_from_world;
+  for (const StampedPose& pose : ReadTum(folder / "run" / "trajectory.tum")) {
+    cam_from_world[static_cast<int>(std::lround(pose.timestamp * sequence.info().fps))] = pose.world_from_camera.Inverse();
+  }
+  std::map<int, std::vector<double>> reprojection, offset;
+  std::set<std::pair<int, PointId>> ids;
+  std::set<std::tuple<int, double, double>> pixels;
+  for (const CsvPoint& p : points) {
+    outcome->repeated_points += !ids.emplace(p.frame, p.id).second || !pixels.emplace(p.frame, p.u, p.v).second;
+    if (p.frame != init_frame && p.frame != init_frame + 1) continue;
+    const Eigen::Vector2d pixel(p.u, p.v);
+    const auto seen = camera.Project(cam_from_world.at(p.frame) * p.world);
+    const auto from_reference = camera.Project(p.world);
+    if (!seen || !from_reference) continue;
+    reprojection[p.frame].push_back((*seen - pixel).norm());
+    offset[p.frame].push_back((*from_reference - pixel).norm());
+  }
+  for (const auto& [frame, distances] : reprojection) {
+    outcome->first_frames_reprojection_px.push_back(Median(distances));
+    outcome->first_frames_offset_from_reference_px.push_back(Median(offset.at(frame)));
+  }
+}
+
 MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& options, int width = 320,
                               int height = 240) {
   const fs::path folder = UniqueTempFolder("nrslam_monocular_" + preset);
@@ -835,11 +872,17 @@ MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& op
         static_cast<double>(std::count_if(errors.begin(), errors.end(), [](double e) { return e > std::log(2.0); })) /
         static_cast<double>(errors.size());
   }
+  FirstTrackedFrames(points, folder, outcome.summary.init_frame, &outcome);
   outcome.rigid_dba = CountLines(folder / "run" / "run.log", "DBA rigid");
   outcome.deformable_dba = CountLines(folder / "run" / "run.log", "DBA deformable");
   std::cout << preset << " monocular " << width << "x" << height << ": init at " << outcome.summary.init_frame << ", " << outcome.new_points
             << " new points, RMSE " << outcome.summary.rmse_mm << " mm (a flat map: " << outcome.summary.rmse_flat_mm
-            << " mm), DBA windows rigid / deformable: " << outcome.rigid_dba << " / " << outcome.deformable_dba << "\n";
+            << " mm), DBA windows rigid / deformable: " << outcome.rigid_dba << " / " << outcome.deformable_dba
+            << "; first two tracked frames, median px from their own pose's projection / the reference view's:";
+  for (size_t i = 0; i < outcome.first_frames_reprojection_px.size(); ++i) {
+    std::cout << " " << outcome.first_frames_reprojection_px[i] << " / " << outcome.first_frames_offset_from_reference_px[i];
+  }
+  std::cout << "\n";
   fs::remove_all(folder);
   return outcome;
 }
@@ -850,6 +893,18 @@ void ExpectInitialisedAndTrackedToTheEnd(const RunSummary& summary) {
   EXPECT_EQ(summary.maps, 1);
   EXPECT_EQ(summary.frames_lost, 0);
   EXPECT_EQ(summary.frames_tracked, 60 - summary.init_frame);
+}
+
+// reference-behaviour §9.2: the reference's keyframe queue reset the first two tracked frames
+// to the reference view (its identity pose and its pixels), and a track demoted from 3D could
+// be triangulated into a second map point.
+void ExpectTheFirstFramesTheirOwnAndEachPointOnce(const MonocularOutcome& outcome) {
+  ASSERT_EQ(outcome.first_frames_reprojection_px.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_LT(outcome.first_frames_reprojection_px[i], 1.0) << "tracked frame " << i;
+    EXPECT_GT(outcome.first_frames_offset_from_reference_px[i], 2.0) << "tracked frame " << i;
+  }
+  EXPECT_EQ(outcome.repeated_points, 0);
 }
 
 TEST(MonocularRun, RigidSceneGivesAnAccurateGrowingMap) {
@@ -865,6 +920,7 @@ TEST(MonocularRun, RigidSceneGivesAnAccurateGrowingMap) {
   // A still scene fits one shape: after the warm-up every DBA window is adjusted rigidly.
   EXPECT_GT(outcome.rigid_dba, 0);
   EXPECT_EQ(outcome.deformable_dba, 0);
+  ExpectTheFirstFramesTheirOwnAndEachPointOnce(outcome);
 }
 
 // sim-0 (60 frames, 320x240) rendered through a calibration file and run through the whole
@@ -931,6 +987,7 @@ TEST(MonocularRun, DeformingSceneIsTrackedToTheEnd) {
   ASSERT_TRUE(outcome.summary.births.mean && outcome.summary.births.median);
   EXPECT_NEAR(*outcome.summary.births.mean, Mean(outcome.birth_log_errors), 1e-6);
   EXPECT_NEAR(*outcome.summary.births.median, Median(outcome.birth_log_errors), 1e-6);
+  ExpectTheFirstFramesTheirOwnAndEachPointOnce(outcome);
 }
 
 // run.restart_on_depth_change gives a map up on the first frame its median depth moves beyond
