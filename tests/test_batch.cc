@@ -1736,6 +1736,27 @@ TEST(BatchEvaluation, ACrashingOrMissingRunnerIsARecordedFailure) {
   std::filesystem::remove_all(folder);
 }
 
+// A program that fails names the fault in a heading and lists what it found under it; the
+// failure gives the heading with the list's first items, not the list's last line alone.
+TEST(BatchEvaluation, AFailureGivesTheProgramsClosingMessageWithTheFirstOfItsList) {
+  const auto folder = UniqueTempFolder("batch_list");
+  EvaluationPlan plan;
+  const std::filesystem::path runner = StandInRunner(folder,
+                                                     "echo 'frame 1/5 tracking'\n"
+                                                     "echo 'nrslam_run: invalid sequence seq:' >&2\n"
+                                                     "for i in 0 1 2 3 4; do echo \"  - rgb/00000$i.png must be 8-bit\" >&2; done\n"
+                                                     "echo '  - 25 more bad files in rgb/' >&2\n"
+                                                     "exit 1\n",
+                                                     1, &plan);
+  ExecutePlan(plan, Programs{kPrograms.simulate, runner, kPrograms.import, kPrograms.eval}, 1, [](const std::string&) {});
+  const std::vector<RunResult> results = CollectResults(plan);
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].error, "exit code 1: nrslam_run: invalid sequence seq: rgb/000000.png must be 8-bit; "
+                              "rgb/000001.png must be 8-bit; rgb/000002.png must be 8-bit; 3 more line(s) in " +
+                                  plan.runs[0].run_folder.string() + ".log");
+  std::filesystem::remove_all(folder);
+}
+
 TEST(Progress, DurationsReadAsAPersonWouldSayThem) {
   EXPECT_EQ(FormatDuration(0), "0 s");
   EXPECT_EQ(FormatDuration(-3), "0 s");

@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "nrslam/batch/sequence_cache.h"
 #include "nrslam/io/sequence_info.h"
@@ -27,16 +28,35 @@ void WriteFailure(const RunJob& run, const std::string& stage, const std::string
   WriteTextFile(run.run_folder / "failure.json", Json{{"stage", stage}, {"error", message}}.dump(2) + '\n');
 }
 
-// The last non-empty line of a log, where the programs put their error message.
-std::string LastLine(const std::filesystem::path& log) {
+// The message a program ended its log with, where the programs put their error: its last
+// line that is not indented, with the indented list under it (a sequence's bad files, say) on
+// one line. A long list gives its first items and says where the rest is: its last line alone
+// would be "25 more bad files in rgb/", which names neither the sequence nor the fault.
+std::string ClosingMessage(const std::filesystem::path& log, const std::filesystem::path& kept_as) {
+  constexpr size_t kItemsShown = 3;
   std::ifstream stream(log);
-  std::string line, last;
+  std::string line, heading;
+  std::vector<std::string> items;
   while (std::getline(stream, line)) {
     const size_t carriage = line.rfind('\r');  // progress lines overwrite themselves
     if (carriage != std::string::npos) line = line.substr(carriage + 1);
-    if (line.find_first_not_of(" \t") != std::string::npos) last = line;
+    const size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos) continue;
+    if (start == 0 || heading.empty()) {
+      heading = line.substr(start);
+      items.clear();
+    } else {
+      items.push_back(line.substr(line.compare(start, 2, "- ") == 0 ? start + 2 : start));
+    }
   }
-  return last;
+  std::string message = heading;
+  for (size_t i = 0; i < std::min(items.size(), kItemsShown); ++i) {
+    message += (i == 0 && !message.empty() && message.back() == ':' ? " " : "; ") + items[i];
+  }
+  if (items.size() > kItemsShown) {
+    message += "; " + std::to_string(items.size() - kItemsShown) + " more line(s) in " + kept_as.string();
+  }
+  return message;
 }
 
 const std::filesystem::path& ProgramOf(const RunJob& run, const Programs& programs) {
@@ -166,7 +186,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
   RunCommands(prepares, jobs, [&](size_t k, const ProcessOutcome& outcome) {
     const PrepareJob& prepare = plan.prepares[prepare_index[k]];
     const std::filesystem::path& partial = partials[k];
-    const std::string why = LastLine(prepares[k].log);
+    const std::string why = ClosingMessage(prepares[k].log, CacheLog(prepare.folder));
     std::error_code not_moved;
     if (outcome.ok()) std::filesystem::rename(partial, prepare.folder, not_moved);
     // Another evaluation that prepared the same sequence first made the same files.
@@ -237,7 +257,7 @@ void ExecutePlan(const EvaluationPlan& plan, const Programs& programs, int jobs,
       ++interrupted;  // not a failure of the run: it is left unfinished, for the next evaluation
       return;
     }
-    const std::string why = LastLine(runs[k].log);
+    const std::string why = ClosingMessage(runs[k].log, runs[k].log);
     const std::string how = outcome.ok() ? "exited with 0 but left no finished run" : outcome.Describe();
     WriteFailure(run, "run", how + (why.empty() ? "" : ": " + why));
     progress(counter + name + " FAILED (" + how + ")" + (why.empty() ? "" : ": " + why));
