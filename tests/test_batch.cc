@@ -572,6 +572,9 @@ TEST(Results, RevisionsAreListedOnceSortedWithTheUnrecordedLast) {
   EXPECT_EQ(DescribeRevisions(std::vector<std::string>{}), "not recorded");
   EXPECT_EQ(DescribeRevisions(std::vector<std::string>{"b", "", "a", "b"}), "a, b, not recorded");
   EXPECT_EQ(DescribeRevisions(std::vector<std::string>{"b", "b"}), "b");
+  RunResult failed = Result("a", 1.0, 60);
+  failed.status = "failed";
+  EXPECT_EQ(DescribeRevisions(std::vector<RunResult>{failed, failed}), "none: every run failed");
   RunResult run = Result("a", 1.0, 60);
   run.revision = "0123456789ab";
   EXPECT_EQ(ResultsFromJson(ToJson({run}))[0].revision, "0123456789ab");

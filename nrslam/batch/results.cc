@@ -109,6 +109,7 @@ std::string DescribeRevisions(const std::vector<RunResult>& results) {
   for (const RunResult& r : results) {
     if (r.status != "failed") revisions.push_back(r.revision);  // a failed run made nothing to name
   }
+  if (revisions.empty() && !results.empty()) return "none: every run failed";
   return DescribeRevisions(revisions);
 }
 

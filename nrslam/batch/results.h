@@ -54,7 +54,8 @@ std::string RunKey(const RunResult& result);
 // The distinct revisions that made `revisions` (RunResult::revision; "" = not recorded), sorted
 // and joined by ", ", e.g. "1a2b3c4d5e6f, not recorded": what code a set of results came from.
 std::string DescribeRevisions(const std::vector<std::string>& revisions);
-// The same over the runs that did not fail (a failed run wrote no config.json to name its code).
+// The same over the runs that did not fail (a failed run wrote no config.json to name its
+// code); "none: every run failed" when every one did.
 std::string DescribeRevisions(const std::vector<RunResult>& results);
 // Whether two sets of runs were made by the same code, by their code fingerprints
 // (RunResult::code): "the same code" when every run on both sides records one and the same
