@@ -541,6 +541,9 @@ TEST(Results, MapDepthChangeRoundTripsAndAFarOneIsNoted) {
       << notes[1];
   EXPECT_TRUE(RunNotes(read[1]).empty());
   EXPECT_TRUE(RunNotes(read[2]).empty());
+  // A folder that is not an evaluation's output is named as such (nrslam_eval diff reads two).
+  EXPECT_NE(ErrorMessage([&] { ReadResults(folder / "runs"); }).find("is not a folder"), std::string::npos);
+  EXPECT_NE(ErrorMessage([&] { ReadResults(folder.parent_path()); }).find("holds no results.json"), std::string::npos);
   std::ifstream csv(folder / "results.csv");
   std::string header, first;
   std::getline(csv, header);

@@ -271,6 +271,10 @@ std::vector<RunResult> ResultsFromJson(const Json& json) {
 }
 
 std::vector<RunResult> ReadResults(const std::filesystem::path& folder) {
+  if (!std::filesystem::is_directory(folder)) throw Error(folder.string() + " is not a folder");
+  if (!std::filesystem::exists(folder / "results.json")) {
+    throw Error(folder.string() + " holds no results.json: it is not the output folder (--out) of an evaluation");
+  }
   return ResultsFromJson(ReadJsonFile(folder / "results.json"));
 }
 
