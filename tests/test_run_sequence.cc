@@ -821,11 +821,10 @@ std::vector<double> NewPointLogDepthErrors(const std::vector<CsvPoint>& points, 
   return births.log_errors();
 }
 
-
-// Fills the outcome's pixel checks of a monocular run with one map, whose world frame is the
-// reference camera's.
-void FirstTrackedFrames(const std::vector<CsvPoint>& points, const fs::path& folder, int init_frame,
-                        MonocularOutcome* outcome) {
+// Fills the outcome's pixel checks (the first two tracked frames, points reported twice) of a
+// monocular run with one map, whose world frame is the reference camera's.
+void FillPixelChecks(const std::vector<CsvPoint>& points, const fs::path& folder, int init_frame,
+                     MonocularOutcome* outcome) {
   const SequenceReader sequence(folder / "sequence");
   const Camera& camera = sequence.info().camera;
   std::map<int, Rigid3> cam_from_world;
@@ -872,7 +871,7 @@ MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& op
         static_cast<double>(std::count_if(errors.begin(), errors.end(), [](double e) { return e > std::log(2.0); })) /
         static_cast<double>(errors.size());
   }
-  FirstTrackedFrames(points, folder, outcome.summary.init_frame, &outcome);
+  FillPixelChecks(points, folder, outcome.summary.init_frame, &outcome);
   outcome.rigid_dba = CountLines(folder / "run" / "run.log", "DBA rigid");
   outcome.deformable_dba = CountLines(folder / "run" / "run.log", "DBA deformable");
   std::cout << preset << " monocular " << width << "x" << height << ": init at " << outcome.summary.init_frame << ", " << outcome.new_points
