@@ -675,6 +675,7 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   damaged.input.sudden_occlusions = 2;
   damaged.input.view_jumps = 1;
   damaged.input.static_fraction = 0.125;
+  damaged.input.frames_past_end = 40;
   const RunResult fine = Result("sim-0", 0.1, 60);
   std::stringstream table;
   PrintResults({damaged, fine}, table);
@@ -693,8 +694,12 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
                              "background) and was left out (static_mask.png)"),
             std::string::npos)
       << table.str();
+  EXPECT_NE(table.str().find("sim-2: 40 frames of the range asked for (run.last_frame) lie past the sequence's end: "
+                             "the run stopped at its last frame"),
+            std::string::npos)
+      << table.str();
   EXPECT_EQ(table.str().find("sim-0:"), std::string::npos) << table.str();
-  EXPECT_EQ(RunNotes(damaged).size(), 5u);
+  EXPECT_EQ(RunNotes(damaged).size(), 6u);
   EXPECT_TRUE(RunNotes(fine).empty());
   // The report's section of the run says the same.
   const auto folder = UniqueTempFolder("results_notes_report");
@@ -714,14 +719,18 @@ TEST(Results, FramesLostOrLeftUnscoredByUnreadableFilesOrDropoutsAreShownAndKept
   EXPECT_EQ(read[1].input.sudden_occlusions, 0);
   EXPECT_EQ(read[0].input.view_jumps, 1);
   EXPECT_EQ(read[1].input.view_jumps, 0);
+  EXPECT_EQ(read[0].input.frames_past_end, 40);
+  EXPECT_EQ(read[1].input.frames_past_end, 0);
   const auto csv_folder = UniqueTempFolder("results_notes_csv");
   WriteResults({damaged}, csv_folder);
   std::ifstream csv(csv_folder / "results.csv");
   std::string header, row;
   std::getline(csv, header);
   std::getline(csv, row);
-  EXPECT_NE(header.find(",frames_dropout,sudden_occlusions,view_jumps,static_fraction,"), std::string::npos) << header;
-  EXPECT_NE(row.find(",3,2,1,0.125,"), std::string::npos) << row;
+  EXPECT_NE(header.find(",frames_dropout,sudden_occlusions,view_jumps,static_fraction,frames_past_end,"),
+            std::string::npos)
+      << header;
+  EXPECT_NE(row.find(",3,2,1,0.125,40,"), std::string::npos) << row;
   EXPECT_EQ(std::count(header.begin(), header.end(), ','), std::count(row.begin(), row.end(), ','));
   std::filesystem::remove_all(csv_folder);
   EXPECT_EQ(read[0].input.static_fraction, 0.125);

@@ -1339,6 +1339,18 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   EXPECT_EQ(monocular.stop_reason.rfind("initialising: ", 0), 0u) << monocular.stop_reason;
   // The sequence has ground truth; the run has nothing to score.
   EXPECT_NE(DescribeSummary(monocular).find("no frame tracked, no RMSE"), std::string::npos) << DescribeSummary(monocular);
+  EXPECT_EQ(monocular.input.frames_past_end, 0);
+  // A range past the end runs to the end, and says so.
+  SystemOptions beyond_the_end;
+  beyond_the_end.run.last_frame = 5;
+  const RunSummary to_the_end = RunSequence(folder, beyond_the_end, folder / "beyond");
+  EXPECT_EQ(to_the_end.frames_total, 2);
+  EXPECT_EQ(to_the_end.input.frames_past_end, 3);
+  EXPECT_NE(DescribeSummary(to_the_end).find("3 frames of the range asked for (run.last_frame) lie past the sequence's end"),
+            std::string::npos)
+      << DescribeSummary(to_the_end);
+  EXPECT_EQ(ReadJsonFile(folder / "beyond" / "summary.json").at("frames_past_end"), 3);
+  EXPECT_NE(FileText(folder / "beyond" / "run.log").find("3 frames of the range asked for"), std::string::npos);
   fs::remove_all(folder);
 }
 

@@ -375,7 +375,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
   std::ostringstream csv;
   csv << "sequence,sweep_point,status,init_frame,frames_tracked,frames_total,frames_evaluated,"
          "frames_unreadable,frames_unreadable_after_init,frames_groundtruth_unreadable,frames_sparse_groundtruth,"
-         "frames_dropout,sudden_occlusions,view_jumps,static_fraction,rmse_mm,rmse_median_mm,rmse_flat_mm,"
+         "frames_dropout,sudden_occlusions,view_jumps,static_fraction,frames_past_end,rmse_mm,rmse_median_mm,rmse_flat_mm,"
          "rmse_map_scale_mm,rmse_median_scale_mm,ate_rmse_mm,fps,peak_memory_mb,births_evaluated,birth_log_error_mean,"
          "birth_log_error_median,map_depth_change,map_depth_change_beyond_from,maps_given_up,revision,code,error\n";
   for (const RunResult& r : results) {
@@ -384,7 +384,7 @@ void WriteResults(const std::vector<RunResult>& results, const std::filesystem::
         << r.input.frames_unreadable << ',' << r.input.frames_unreadable_after_init << ','
         << r.input.frames_groundtruth_unreadable << ',' << r.input.frames_sparse_groundtruth << ','
         << r.input.frames_dropout << ',' << r.input.sudden_occlusions << ',' << r.input.view_jumps << ','
-        << r.input.static_fraction << ','
+        << r.input.static_fraction << ',' << r.input.frames_past_end << ','
         << r.rmse_mm << ',' << r.rmse_median_mm << ','
         << RecordedField(r.rmse_flat_mm) << ',' << RecordedField(r.rmse_map_scale_mm) << ','
         << RecordedField(r.rmse_median_scale_mm) << ',' << RecordedField(r.ate_mm) << ',' << r.fps << ','

@@ -55,6 +55,13 @@ std::string OcclusionText(int sudden_occlusions) {
          ": most of the view hidden at once, the tracks left matching well (the frames used; metrics.csv notes them)";
 }
 
+std::string PastEndText(int frames_past_end) {
+  if (frames_past_end == 0) return "";
+  return std::to_string(frames_past_end) + (frames_past_end == 1 ? " frame" : " frames") +
+         " of the range asked for (run.last_frame) " + (frames_past_end == 1 ? "lies" : "lie") +
+         " past the sequence's end: the run stopped at its last frame";
+}
+
 std::string ViewJumpText(int view_jumps) {
   if (view_jumps == 0) return "";
   return std::to_string(view_jumps) + (view_jumps == 1 ? " jump of the view" : " jumps of the view") +
@@ -171,7 +178,7 @@ double MedianDepth(const std::vector<DepthPoint>& points) {
 
 std::vector<std::string> InputEffects::Notes() const {
   std::vector<std::string> notes;
-  for (std::string note : {UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
+  for (std::string note : {PastEndText(frames_past_end), UnreadableInputText(frames_unreadable, frames_groundtruth_unreadable),
                            SparseGroundTruthText(frames_sparse_groundtruth), DropoutText(frames_dropout),
                            OcclusionText(sudden_occlusions), ViewJumpText(view_jumps),
                            StaticRegionText(static_fraction), OutsideImageText(estimates_outside_image),

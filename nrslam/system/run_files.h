@@ -57,9 +57,12 @@ struct InputEffects {
   // (DepthCorrelation below kInverseDepthCorrelation), recorded only when they are most of
   // them: inverse depth or disparity taken for depth.
   int frames_depth_inverted = 0;
-  // One note each, those that apply, in the order the runner and nrslam_eval print them:
-  // unreadable files, sparse ground truth, image dropouts, sudden occlusions, jumps of the view,
-  // static regions, estimates outside the image, inverted depth.
+  // Frames of the range asked for (run.last_frame) that lie past the sequence's end: the run
+  // stops at its last frame, and a sweep or batch that meant a longer sequence can tell.
+  int frames_past_end = 0;
+  // One note each, those that apply, in the order the runner and nrslam_eval print them: a
+  // range past the end, unreadable files, sparse ground truth, image dropouts, sudden
+  // occlusions, jumps of the view, static regions, estimates outside the image, inverted depth.
   std::vector<std::string> Notes() const;
 };
 // Under the same flat keys in summary.json and in a results.json row; a key missing (results
@@ -67,7 +70,7 @@ struct InputEffects {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(InputEffects, frames_unreadable, frames_groundtruth_unreadable,
                                                 frames_unreadable_after_init, frames_sparse_groundtruth,
                                                 frames_dropout, sudden_occlusions, view_jumps, static_fraction,
-                                                estimates_outside_image, frames_depth_inverted)
+                                                estimates_outside_image, frames_depth_inverted, frames_past_end)
 
 // A change of a map's median depth beyond this factor, either way, gets a note: more than the
 // depth of an endoscopic scene changes over a sequence, less than a collapsing scale gives.
@@ -161,6 +164,10 @@ struct RunSummary {
 // How a run that ends without tracking stopped: "lost from frame 12: only 7 points left after
 // outlier rejection" or "never initialised: …"; "" when `reason` is empty (it ends tracking).
 std::string DescribeStop(int init_frame, int stop_frame, const std::string& reason);
+
+// "80 frames of the range asked for (run.last_frame) lie past the sequence's end: the run
+// stopped at its last frame"; "" when none.
+std::string PastEndText(int frames_past_end);
 
 // What damaged input cost a run, e.g. "1 frame unreadable (lost); ground-truth depth unreadable
 // on 2 tracked frames (not scored); metrics.csv names the files"; "" when nothing.

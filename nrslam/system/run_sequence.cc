@@ -183,6 +183,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
   double ms_initialisation = 0, ms_tracking = 0, ms_tracking_linear_solve = 0, ms_dba = 0, ms_triangulation = 0;
   RunSummary summary;
   summary.frames_total = last - first;
+  summary.input.frames_past_end = std::max(0, options.run.last_frame - reader.frame_count());
+  if (summary.input.frames_past_end > 0) log << PastEndText(summary.input.frames_past_end) << '\n';
   const auto start_map = [&](const FrameResult& started, const std::optional<Keyframe>& reference) {
     if (options.run.mapping) mapper.StartMap(started, tracker, reference);
     ++maps;
