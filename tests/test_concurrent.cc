@@ -1,0 +1,61 @@
+// RunConcurrently (util/concurrent.h): both tasks run, at the same time, and an exception from
+// either reaches the caller instead of ending the program inside an OpenMP region.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "nrslam/util/concurrent.h"
+
+namespace nrslam {
+namespace {
+
+// Each task announces itself and waits (up to 10 s) for the other: run one after the other,
+// the first would find the second never started.
+TEST(RunConcurrently, RunsBothTasksAtOnce) {
+  std::mutex mutex;
+  std::condition_variable changed;
+  int started = 0;
+  bool first_met_second = false, second_met_first = false;
+  const auto meet = [&](bool* met) {
+    std::unique_lock<std::mutex> lock(mutex);
+    ++started;
+    changed.notify_all();
+    *met = changed.wait_for(lock, std::chrono::seconds(10), [&] { return started == 2; });
+  };
+  RunConcurrently([&] { meet(&first_met_second); }, [&] { meet(&second_met_first); });
+  EXPECT_EQ(started, 2);
+  EXPECT_TRUE(first_met_second);
+  EXPECT_TRUE(second_met_first);
+}
+
+std::string MessageOf(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(nothing thrown)";
+}
+
+TEST(RunConcurrently, RethrowsATasksExceptionAfterBothEnd) {
+  bool first_ended = false;
+  EXPECT_EQ(MessageOf([&] {
+              RunConcurrently([&] { first_ended = true; }, [] { throw std::runtime_error("second failed"); });
+            }),
+            "second failed");
+  EXPECT_TRUE(first_ended);
+  EXPECT_EQ(MessageOf([] {
+              RunConcurrently([] { throw std::runtime_error("first failed"); },
+                              [] { throw std::logic_error("second failed"); });
+            }),
+            "first failed");
+  EXPECT_EQ(MessageOf([] { RunConcurrently([] {}, [] {}); }), "(nothing thrown)");
+}
+
+}  // namespace
+}  // namespace nrslam
