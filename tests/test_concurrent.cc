@@ -6,10 +6,10 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
-#include <stdexcept>
-#include <string>
 
+#include "error_message.h"
 #include "nrslam/util/concurrent.h"
+#include "nrslam/util/error.h"
 
 namespace nrslam {
 namespace {
@@ -36,28 +36,16 @@ TEST(RunConcurrently, RunsBothTasksAtOnce) {
   EXPECT_TRUE(second_met_first);
 }
 
-std::string MessageOf(const std::function<void()>& call) {
-  try {
-    call();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(nothing thrown)";
-}
-
 TEST(RunConcurrently, RethrowsATasksExceptionAfterBothEnd) {
   bool first_ended = false;
-  EXPECT_EQ(MessageOf([&] {
-              RunConcurrently([&] { first_ended = true; }, [] { throw std::runtime_error("second failed"); });
-            }),
+  EXPECT_EQ(ErrorMessage([&] { RunConcurrently([&] { first_ended = true; }, [] { throw Error("second failed"); }); }),
             "second failed");
   EXPECT_TRUE(first_ended);
-  EXPECT_EQ(MessageOf([] {
-              RunConcurrently([] { throw std::runtime_error("first failed"); },
-                              [] { throw std::logic_error("second failed"); });
+  EXPECT_EQ(ErrorMessage([] {
+              RunConcurrently([] { throw Error("first failed"); }, [] { throw Error("second failed"); });
             }),
             "first failed");
-  EXPECT_EQ(MessageOf([] { RunConcurrently([] {}, [] {}); }), "(nothing thrown)");
+  EXPECT_EQ(ErrorMessage([] { RunConcurrently([] {}, [] {}); }), "");
 }
 
 }  // namespace
