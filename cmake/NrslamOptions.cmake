@@ -18,8 +18,4 @@ set(NRSLAM_SANITIZE "" CACHE STRING "sanitizers to build with (-fsanitize=...), 
 if(NRSLAM_SANITIZE)
   add_compile_options(-fsanitize=${NRSLAM_SANITIZE} -fno-sanitize-recover=all -fno-omit-frame-pointer)
   add_link_options(-fsanitize=${NRSLAM_SANITIZE})
-  # Under AddressSanitizer Eigen stops trusting glibc's malloc to align and pads its blocks by
-  # hand, but Debian's Ceres (built without it) does not: a matrix Ceres allocates and our
-  # code frees (ceres::GradientChecker's results) would be freed at the wrong address.
-  add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
 endif()
