@@ -9,6 +9,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "nrslam/batch/run_folder.h"
 #include "nrslam/batch/svg_plot.h"

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <optional>
 
 #include "nrslam/io/sequence_info.h"

@@ -6,6 +6,7 @@
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
 
+#include <functional>
 #include <memory>
 #include <utility>
 

@@ -5,6 +5,7 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
+#include <set>
 #include <unordered_map>
 
 #include "nrslam/camera/reprojection_cost.h"

@@ -17,6 +17,7 @@
 #include <future>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "nrslam/camera/camera.h"

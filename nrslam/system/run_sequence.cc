@@ -9,6 +9,7 @@
 #include <fstream>
 #include <future>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <utility>
 
