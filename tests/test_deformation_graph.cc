@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
+#include <utility>
 
 #include "nrslam/deformation/deformation_graph.h"
 #include "nrslam/util/error.h"

@@ -3,6 +3,8 @@
 // including the reference's compacted-index bug (reference-behaviour §9.2).
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <optional>
 #include <set>
 
 #include <opencv2/imgproc.hpp>
@@ -11,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <utility>
 
 #include "temp_folder.h"
 #include "nrslam/camera/reprojection_cost.h"

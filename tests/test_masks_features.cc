@@ -2,6 +2,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+
 #include "frontend_fixtures.h"
 #include "nrslam/frontend/feature_detector.h"
 #include "nrslam/frontend/masks.h"

@@ -21,6 +21,7 @@
 #include <set>
 #include <sstream>
 #include <tuple>
+#include <utility>
 
 #include "camera_fixtures.h"
 #include "error_message.h"

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <optional>
 
 #include "temp_folder.h"
 #include "nrslam/io/sequence_reader.h"
