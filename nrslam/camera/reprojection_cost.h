@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <limits>
+#include <vector>
 
 #include "nrslam/camera/camera.h"
 #include "nrslam/geometry/rigid3.h"
@@ -76,7 +77,6 @@ struct DeformedReprojectionCost {
   }
 };
 
-// The functors above for the camera's model.
 // Squared pixel distance between `observed` and the projection of `world`; infinite when the
 // point does not project (behind the camera, off the model's domain).
 inline double SquaredReprojectionError(const Camera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& world,
@@ -85,6 +85,7 @@ inline double SquaredReprojectionError(const Camera& camera, const Rigid3& cam_f
   return pixel ? (*pixel - observed).squaredNorm() : std::numeric_limits<double>::infinity();
 }
 
+// The functors above for the camera's model.
 inline ceres::CostFunction* CreateReprojectionCost(const Camera& camera, const Eigen::Vector2d& observed,
                                                    double sigma_px) {
   return VisitCameraModel(camera.model(), [&](auto model) {
