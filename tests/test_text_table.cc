@@ -27,6 +27,19 @@ TEST(TextTable, PrintsFixedWidthColumns) {
             "50% & #1 {a} ~x^2 \\         \n");
 }
 
+TEST(TextTable, AlignsCellsByCharactersNotBytes) {
+  TextTable table({"sequence", "change"});
+  table.AddRow({"colon-\u00fc", "k: 1.1 \u2192 2"});  // ü is 2 bytes in UTF-8, → 3
+  table.AddRow({"colon-ab", "k: 1.1 -> 2"});
+  std::ostringstream text;
+  table.Print(text);
+  EXPECT_EQ(text.str(),
+            "sequence       change\n"
+            "---------------------\n"
+            "colon-\u00fc    k: 1.1 \u2192 2\n"
+            "colon-ab  k: 1.1 -> 2\n");
+}
+
 TEST(TextTable, PrintsAMarkdownPipeTable) {
   std::ostringstream markdown;
   Example().PrintMarkdown(markdown);

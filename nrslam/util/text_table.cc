@@ -3,32 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iomanip>
 
 namespace nrslam {
-
-void TextTable::Print(std::ostream& out) const {
-  std::vector<size_t> widths(header_.size(), 0);
-  auto measure = [&](const std::vector<std::string>& row) {
-    for (size_t c = 0; c < row.size() && c < widths.size(); ++c) widths[c] = std::max(widths[c], row[c].size());
-  };
-  measure(header_);
-  for (const auto& row : rows_) measure(row);
-  auto print_row = [&](const std::vector<std::string>& row) {
-    for (size_t c = 0; c < widths.size(); ++c) {
-      const std::string cell = c < row.size() ? row[c] : "";
-      out << (c ? "  " : "") << (c ? std::right : std::left) << std::setw(static_cast<int>(widths[c])) << cell;
-    }
-    out << '\n';
-  };
-  print_row(header_);
-  size_t total = 0;
-  for (size_t w : widths) total += w;
-  out << std::string(total + 2 * (widths.size() - 1), '-') << '\n';
-  for (const auto& row : rows_) print_row(row);
-}
-
 namespace {
+
+// Terminal columns of a cell: one per UTF-8 code point, not per byte, so that a sequence named
+// "colon-ü" or an option change "a → b" does not push its row out of line.
+size_t DisplayWidth(const std::string& text) {
+  return static_cast<size_t>(std::count_if(text.begin(), text.end(), [](char byte) {
+    return (static_cast<unsigned char>(byte) & 0xC0) != 0x80;  // not a continuation byte
+  }));
+}
 
 std::string MarkdownCell(const std::string& text) {
   std::string escaped;
@@ -59,6 +44,28 @@ std::string JoinCells(const std::vector<std::string>& row, size_t columns, std::
 }
 
 }  // namespace
+
+void TextTable::Print(std::ostream& out) const {
+  std::vector<size_t> widths(header_.size(), 0);
+  auto measure = [&](const std::vector<std::string>& row) {
+    for (size_t c = 0; c < row.size() && c < widths.size(); ++c) widths[c] = std::max(widths[c], DisplayWidth(row[c]));
+  };
+  measure(header_);
+  for (const auto& row : rows_) measure(row);
+  auto print_row = [&](const std::vector<std::string>& row) {
+    for (size_t c = 0; c < widths.size(); ++c) {
+      const std::string cell = c < row.size() ? row[c] : "";
+      const std::string padding(widths[c] - DisplayWidth(cell), ' ');
+      out << (c ? "  " + padding + cell : cell + padding);  // the first column left-aligned, the rest right
+    }
+    out << '\n';
+  };
+  print_row(header_);
+  size_t total = 0;
+  for (size_t w : widths) total += w;
+  out << std::string(total + 2 * (widths.size() - 1), '-') << '\n';
+  for (const auto& row : rows_) print_row(row);
+}
 
 void TextTable::PrintMarkdown(std::ostream& out) const {
   out << "| " << JoinCells(header_, header_.size(), MarkdownCell, " | ") << " |\n|";
