@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   const fs::path work = fs::temp_directory_path() / ("nrslam_bench_system_" + std::to_string(::getpid()));
   // "linear ms" is inside "track ms": the joint solves' linear solver.
   std::printf("%s\n", nrslam::VersionString().c_str());
-  std::printf("%-8s %-10s %6s %7s %9s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
+  std::printf("%-9s %-10s %6s %7s %9s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
               "linear ms", "DBA ms", "triang ms", "RMSE mm", "points");
   for (const std::string& preset : presets) {
     nrslam::SimOptions sim = nrslam::SimPreset(preset);
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
       nrslam::SystemOptions mode = *options;
       mode.tracking.rigid = rigid;
       const nrslam::RunSummary s = nrslam::RunSequence(work / preset, mode, work / (preset + "-run"));
-      std::printf("%-8s %-10s %6d %7.1f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %8zu\n", preset.c_str(),
+      std::printf("%-9s %-10s %6d %7.1f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %8zu\n", preset.c_str(),
                   rigid ? "rigid" : "deformable", s.frames_tracked, s.fps, s.ms_initialisation, s.ms_tracking,
                   s.ms_tracking_linear_solve, s.ms_dba, s.ms_triangulation, s.rmse_mm, s.map_points);
       std::fflush(stdout);
