@@ -36,5 +36,13 @@ TEST(ProgressLine, OnATerminalOneLineIsRewrittenAndBlankedWhereItShrinks) {
   EXPECT_EQ(out.str(), "\rframe 9/10\rframe 10/10\rdone       \n\rnext\n");
 }
 
+TEST(ProgressLine, OnATerminalAShrinkingLineIsBlankedByColumnsNotBytes) {
+  std::ostringstream out;
+  ProgressLine progress(out, /*in_place=*/true, 3600);
+  progress.Update("sim-0-abcd", false);
+  progress.Update("sim-0-\u00fc\u00fc", true);  // 8 columns in 10 bytes: 2 columns to blank
+  EXPECT_EQ(out.str(), "\rsim-0-abcd\rsim-0-\u00fc\u00fc  \n");
+}
+
 }  // namespace
 }  // namespace nrslam

@@ -4,6 +4,8 @@
 
 #include <iostream>
 
+#include "nrslam/util/text_table.h"
+
 namespace nrslam {
 
 ProgressLine::ProgressLine(std::ostream& out, bool in_place, double interval_s)
@@ -14,8 +16,9 @@ ProgressLine ProgressLine::OnStderr() { return ProgressLine(std::cerr, isatty(ST
 void ProgressLine::Update(const std::string& line, bool last) {
   if (in_place_) {
     out_ << '\r' << line;
-    if (line.size() < previous_length_) out_ << std::string(previous_length_ - line.size(), ' ');
-    previous_length_ = line.size();
+    const size_t width = DisplayWidth(line);  // a name with "ü" takes fewer columns than bytes
+    if (width < previous_length_) out_ << std::string(previous_length_ - width, ' ');
+    previous_length_ = width;
     if (last) {
       out_ << '\n';
       previous_length_ = 0;

@@ -5,15 +5,14 @@
 #include <cstdio>
 
 namespace nrslam {
-namespace {
 
-// Terminal columns of a cell: one per UTF-8 code point, not per byte, so that a sequence named
-// "colon-ü" or an option change "a → b" does not push its row out of line.
 size_t DisplayWidth(const std::string& text) {
   return static_cast<size_t>(std::count_if(text.begin(), text.end(), [](char byte) {
     return (static_cast<unsigned char>(byte) & 0xC0) != 0x80;  // not a continuation byte
   }));
 }
+
+namespace {
 
 std::string MarkdownCell(const std::string& text) {
   std::string escaped;

@@ -29,6 +29,9 @@ std::string FormatFixed(double value, int decimals);
 // A duration as a person reads it, rounded to what matters at its size: "42 s", "6 min",
 // "1 h 20 min".
 std::string FormatDuration(double seconds);
+// Terminal columns of a text: one per UTF-8 code point, not per byte, so that a sequence named
+// "colon-ü" or an option change "a → b" does not push a table's row out of line.
+size_t DisplayWidth(const std::string& text);
 // The items with `separator` between them: Join({"a", "b"}, ", ") == "a, b".
 std::string Join(const std::vector<std::string>& items, const std::string& separator);
 
