@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
     if (!unreadable.empty()) info.provenance["depth"]["frames_without_input"] = unreadable;
     fs::remove_all(fs::path(folder) / "depth");
     fs::rename(staging / "depth", fs::path(folder) / "depth");
-    nrslam::SequenceWriter(folder, info, true, nrslam::SequenceWriter::Target::kExistingSequence);  // sequence.json
+    // Constructing the writer rewrites sequence.json, which now lists the depth's provenance.
+    const nrslam::SequenceWriter with_depth(folder, info, true, nrslam::SequenceWriter::Target::kExistingSequence);
     fs::remove_all(staging);
     std::cout << "wrote depth for " << sequence.frame_count() << " frames into " << folder << "/depth";
     if (!unreadable.empty()) {
