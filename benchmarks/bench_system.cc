@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bench_options.h"
+#include "host_load.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/util/memory_usage.h"
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   const fs::path work = fs::temp_directory_path() / ("nrslam_bench_system_" + std::to_string(::getpid()));
   // "linear ms" is inside "track ms": the joint solves' linear solver.
   std::printf("%s\n", nrslam::VersionString().c_str());
+  PrintHostLoad();
   std::printf("%-9s %-10s %6s %7s %9s %9s %9s %9s %9s %9s %8s\n", "preset", "mode", "frames", "fps", "init ms", "track ms",
               "linear ms", "DBA ms", "triang ms", "RMSE mm", "points");
   for (const std::string& preset : presets) {

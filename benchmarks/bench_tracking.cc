@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bench_options.h"
+#include "host_load.h"
 #include "nrslam/io/depth_encoding.h"
 #include "nrslam/sim/renderer.h"
 #include "nrslam/sim/sim_options.h"
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
   // "solve" and "linear" are inside "deform": Ceres's joint solves and their linear solver;
   // "ahead" is KLT time spent on the other core during the previous frame (not in "total").
   std::printf("%s\n", nrslam::VersionString().c_str());
+  PrintHostLoad();
   if (repeats > 1) std::printf("medians over %d repeats, the modes run in turn\n", repeats);
   std::printf("%-9s %-10s %7s %7s %11s %7s %8s %8s %8s %9s %8s %9s %8s %8s\n", "preset", "mode", "tracked", "fps",
               "fps range", "vs def", "klt ms", "ahead ms", "pose ms", "deform ms", "solve ms", "linear ms", "total ms",
