@@ -1,7 +1,8 @@
 // Whole-system speed and memory: monocular NR-SLAM (initialisation, tracking, DBA,
 // triangulation) over simulated sequences at 640x480, run through the offline runner
 // (reading images and writing the run folder included; rendering is done beforehand and
-// not timed). Prints fps, mean ms per frame of each stage and the peak resident memory.
+// not timed). Prints the host's load average before the first run, then fps, mean ms per frame
+// of each stage and the peak resident memory.
 // Targets: >= 15 fps; <= 1 GB on a 1000-frame run.
 //   bench_system [FRAMES=120] [PRESET...] [--set module.option=value ...]   e.g. bench_system 1000 sim-3
 #include <unistd.h>

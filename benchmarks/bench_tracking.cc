@@ -7,7 +7,8 @@
 // ("tracked"). This host's speed drifts by ±15 % from minute to minute, so with --repeat the
 // modes are run in turn that many times and each column is the median over the repeats; "vs
 // def" is the median of a mode's fps over the deformable mode's in the same repeat, the
-// figure that drifts least.
+// figure that drifts least. The host's load average before the first run is printed above the
+// table, so that a slow table on a busy host reads as such.
 //   bench_tracking [FRAMES=60] [PRESET ...=sim-0 sim-3 sim-6] [--repeat N=1] [--set module.option=value ...]
 #include <CLI/CLI.hpp>
 
