@@ -17,11 +17,11 @@ void ProgressLine::Update(const std::string& line, bool last) {
   if (in_place_) {
     out_ << '\r' << line;
     const size_t width = DisplayWidth(line);  // a name with "ü" takes fewer columns than bytes
-    if (width < previous_length_) out_ << std::string(previous_length_ - width, ' ');
-    previous_length_ = width;
+    if (width < previous_width_) out_ << std::string(previous_width_ - width, ' ');
+    previous_width_ = width;
     if (last) {
       out_ << '\n';
-      previous_length_ = 0;
+      previous_width_ = 0;
     }
     out_ << std::flush;
     return;

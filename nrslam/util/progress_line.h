@@ -28,7 +28,7 @@ class ProgressLine {
   std::chrono::duration<double> interval_;
   bool printed_any_ = false;
   std::chrono::steady_clock::time_point last_printed_;
-  size_t previous_length_ = 0;  // in place: what a shorter line must blank out
+  size_t previous_width_ = 0;  // in place: columns a shorter line must blank out
 };
 
 }  // namespace nrslam
