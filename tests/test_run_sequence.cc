@@ -785,6 +785,7 @@ struct MonocularOutcome {
   int new_points = 0;     // tracked points that were not in the initial map
   int deformable_candidates = 0;  // summed over metrics.csv
   int rigid_dba = 0, deformable_dba = 0;  // windows after the warm-up, by the model selected (run.log)
+  std::vector<std::map<std::string, std::string>> metrics;  // metrics.csv, a row per frame
   // log(s·z / true depth) of each new point on the frame it was first tracked, with s that
   // frame's median ratio of true to estimated depth (eval/birth_errors.h), from points.csv.
   std::vector<double> birth_log_errors;
@@ -863,6 +864,7 @@ MonocularOutcome RunMonocular(const std::string& preset, const SystemOptions& op
   for (const CsvPoint& p : points) (p.frame == outcome.summary.init_frame ? initial : later).insert(p.id);
   for (PointId id : later) outcome.new_points += initial.count(id) == 0;
   outcome.deformable_candidates = static_cast<int>(SumColumn(folder / "run" / "metrics.csv", "deformable_candidates"));
+  outcome.metrics = ReadCsv(folder / "run" / "metrics.csv");
   outcome.birth_log_errors = NewPointLogDepthErrors(points, SequenceReader(folder / "sequence"), outcome.summary.init_frame);
   std::vector<double> errors;
   for (double error : outcome.birth_log_errors) errors.push_back(std::abs(error));
@@ -1131,6 +1133,34 @@ TEST(MonocularRun, EpipolarGateKeepsFewerGrosslyMisplacedNewPoints) {
   EXPECT_GT(outcome.new_points, 0);
   EXPECT_LT(outcome.deformable_candidates, reference.deformable_candidates);
   EXPECT_LT(outcome.new_point_gross_error_fraction, 0.8 * reference.new_point_gross_error_fraction);
+}
+
+TEST(MonocularRun, BatchDepthCheckTurnsAwayExactlyTheBatchesOutsideItsBound) {
+  // A bound this tight turns away some batches of an ordinary run: every frame's chosen new
+  // points are either all added, with their median depth ratio to their neighbours within
+  // the bound, or none, with it outside. (Every batch is checked here, however small.)
+  SystemOptions options;
+  options.mapping.max_batch_depth_bias = 1.03;
+  options.mapping.batch_check_min_points = 1;
+  const MonocularOutcome outcome = RunMonocular("sim-3", options);
+  ExpectInitialisedAndTrackedToTheEnd(outcome.summary);
+  int added = 0, rejected = 0;
+  for (const auto& row : outcome.metrics) {
+    const double bias = std::stod(row.at("new_point_depth_bias"));
+    const int new_points = std::stoi(row.at("new_points"));
+    if (row.at("batch_rejected") == "1") {
+      ++rejected;
+      EXPECT_EQ(new_points, 0) << "frame " << row.at("frame");
+      EXPECT_TRUE(bias > 1.03 || bias * 1.03 < 1) << "frame " << row.at("frame") << ": " << bias;
+    } else if (new_points > 0) {
+      ++added;
+      EXPECT_LE(bias, 1.03) << "frame " << row.at("frame");
+      EXPECT_GE(bias * 1.03, 1.0) << "frame " << row.at("frame");
+    }
+  }
+  std::cout << "batches added / turned away: " << added << " / " << rejected << "\n";
+  EXPECT_GT(added, 0);
+  EXPECT_GT(rejected, 0);
 }
 
 // The shading prior (frontend/shading.h) with its companions, as the colonoscopy

@@ -35,6 +35,10 @@ struct MappingReport {
   DbaReport dba_report;
   int rigid_candidates = 0, deformable_candidates = 0;  // triangulations that passed their checks
   int new_points = 0;                                   // added this frame (after model selection)
+  // The chosen points' median depth over their neighbours' mean depth, in this frame (0: none
+  // chosen), and whether mapping.max_batch_depth_bias turned them all away.
+  double new_point_depth_bias = 0;
+  bool batch_rejected = false;
   double ms_dba = 0, ms_triangulation = 0;
 };
 
@@ -127,6 +131,7 @@ class Mapper {
   // buffer and the options, so candidates can be triangulated side by side.
   struct CandidatePoints {
     std::optional<Eigen::Vector3d> rigid, deformable;
+    double neighbour_depth = 0;  // its neighbours' mean depth in the newest frame
   };
   // A frame's deformable-triangulation gate: over which span (mapping.deformable_gate_span, or
   // the shortest on a starving frame) and whether its two rays must reproject.

@@ -19,6 +19,7 @@
 #include "nrslam/deformation/regularizer_costs.h"
 #include "nrslam/frontend/masks.h"
 #include "nrslam/frontend/shading.h"
+#include "nrslam/util/median.h"
 #include "nrslam/util/stopwatch.h"
 
 namespace nrslam {
@@ -219,6 +220,7 @@ Mapper::CandidatePoints Mapper::TriangulateCandidate(const CandidateObservation&
     const double z = depth_now(newest.points.at(id).second);
     nearest = std::min(nearest, z);
     farthest = std::max(farthest, z);
+    points.neighbour_depth += z / static_cast<double>(neighbours.size());
   }
   const auto plausible = [&](const Eigen::Vector3d& point) {
     const double z = depth_now(point);
@@ -264,7 +266,9 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
 #pragma omp parallel for schedule(dynamic, 4)
   for (int c = 0; c < count; ++c) solved[c] = TriangulateCandidate(result.candidates[c], gate, map.scale());
   std::vector<std::pair<int, Eigen::Vector3d>> rigid, deformable;  // track id, world position
+  std::unordered_map<int, double> neighbour_depths;                  // by track id
   for (int c = 0; c < count; ++c) {
+    neighbour_depths.emplace(result.candidates[c].track_id, solved[c].neighbour_depth);
     if (solved[c].rigid) rigid.emplace_back(result.candidates[c].track_id, *solved[c].rigid);
     if (solved[c].deformable) deformable.emplace_back(result.candidates[c].track_id, *solved[c].deformable);
   }
@@ -280,20 +284,34 @@ void Mapper::Triangulate(const FrameResult& result, const cv::Mat& bgr, const cv
   if (chosen && !chosen->empty()) {
     std::unordered_map<int, cv::Point2f> pixels;
     for (const CandidateObservation& candidate : result.candidates) pixels.emplace(candidate.track_id, candidate.pixel);
-    std::vector<PointId> created, existing;
-    for (const TrackedPoint& point : result.points) existing.push_back(point.id);
     if (chosen == &deformable && options_.new_point_shading_weight > 0) {
       ApplyShadingPrior(bgr, mask, pixels, &deformable);
     }
+    // The batch as a whole against the map it joins (mapping.max_batch_depth_bias): each
+    // point's own gate allows its neighbours' whole depth range, so a batch can sit deeper or
+    // nearer than the map as a group (an error of the poses shared by all its ray pairs), and
+    // on lap-lobes one such batch decided a run. Turned away, its tracks stay candidates.
+    std::vector<double> ratios;
     for (const auto& [track_id, position] : *chosen) {
-      const cv::Point2f& pixel = pixels.at(track_id);
-      const cv::Point at(std::clamp(cvRound(pixel.x), 0, bgr.cols - 1), std::clamp(cvRound(pixel.y), 0, bgr.rows - 1));
-      const PointId id = map.AddPoint(position, bgr.at<cv::Vec3b>(at), result.frame);
-      created.push_back(id);
-      tracker->PromoteCandidate(track_id, id);
+      ratios.push_back((buffer_.back().cam_from_world * position).z() / neighbour_depths.at(track_id));
     }
-    map.graph().ConnectCovisible(created, existing, map.Positions());
-    report->new_points = static_cast<int>(created.size());
+    report->new_point_depth_bias = MedianInPlace(&ratios);
+    const double limit = options_.max_batch_depth_bias;
+    report->batch_rejected = limit > 0 && static_cast<int>(chosen->size()) >= options_.batch_check_min_points &&
+                             (report->new_point_depth_bias > limit || report->new_point_depth_bias * limit < 1);
+    if (!report->batch_rejected) {
+      std::vector<PointId> created, existing;
+      for (const TrackedPoint& point : result.points) existing.push_back(point.id);
+      for (const auto& [track_id, position] : *chosen) {
+        const cv::Point2f& pixel = pixels.at(track_id);
+        const cv::Point at(std::clamp(cvRound(pixel.x), 0, bgr.cols - 1), std::clamp(cvRound(pixel.y), 0, bgr.rows - 1));
+        const PointId id = map.AddPoint(position, bgr.at<cv::Vec3b>(at), result.frame);
+        created.push_back(id);
+        tracker->PromoteCandidate(track_id, id);
+      }
+      map.graph().ConnectCovisible(created, existing, map.Positions());
+      report->new_points = static_cast<int>(created.size());
+    }
   }
   report->ms_triangulation = MillisecondsSince(start);
 }

@@ -41,6 +41,9 @@ void MappingOptions::Check() const {
                   rigid_dba_max_deformation >= 0,
               "mapping", "need rigid_dba_min_inliers in [0, 1], rigid_dba_min_baseline >= 0 and rigid_dba_max_deformation >= 0");
   CheckOption(max_depth_ratio >= 1, "mapping", "max_depth_ratio must be >= 1");
+  CheckOption(max_batch_depth_bias == 0 || max_batch_depth_bias >= 1, "mapping",
+              "max_batch_depth_bias must be 0 (off) or >= 1");
+  CheckOption(batch_check_min_points >= 1, "mapping", "batch_check_min_points must be >= 1");
   CheckOption(deformable_agreement_ratio == 0 || deformable_agreement_ratio >= 1, "mapping",
               "deformable_agreement_ratio must be 0 (off) or >= 1");
   CheckOption(deformable_max_epipolar_ratio >= 0 && starving_max_epipolar_ratio >= 0, "mapping",

@@ -100,6 +100,14 @@ struct MappingOptions {
   double neighbour_radius_px = 500;  // its neighbours: tracked 3D points within this radius ...
   int neighbours = 10;               // ... at most this many, nearest first
   double max_depth_ratio = 1.25;     // a new point's depth within [nearest/r, r·farthest] of its neighbours'
+  // Not in the reference: a frame's new points (the set model selection chose), when there
+  // are at least batch_check_min_points of them, are all turned away when the median of their
+  // depth over their neighbours' mean depth, in that frame, is outside [1/b, b]; 0 = no such
+  // check. The per-point bound above lets a whole batch lean to one side of the map; a median
+  // of fewer points is their own noise more than a shared lean. Measured (docs/mapping.md,
+  // "Batch depth check"): monocular lap-lobes with its focal length 5 % off 10.15 → 4.51 mm.
+  double max_batch_depth_bias = 1.25;
+  int batch_check_min_points = 10;
   double rigidity_threshold = 0.004; // rigid triangulation needs median ‖δ‖ ≤ this × map scale in every spanned frame
   double rigid_min_parallax_px = 10; // rigid triangulation: parallax window, in pixel angles
   double rigid_max_parallax_px = 20;
@@ -176,7 +184,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MappingOptions, dba, dba_window,
                                                 rigid_warmup_keyframes, rigid_warmup_min_inliers, dba_model_selection, rigid_dba_min_inliers, rigid_dba_min_baseline,
                                                 rigid_dba_max_deformation,
                                                 temporal_window, crowding_radius_px, neighbour_radius_px, neighbours,
-                                                max_depth_ratio, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
+                                                max_depth_ratio, max_batch_depth_bias, batch_check_min_points, rigidity_threshold, rigid_min_parallax_px, rigid_max_parallax_px,
                                                 max_reprojection_px2, deformable_triangulation, deformable_gate_span,
                                                 shortest_gate_below_fraction, starving_two_ray_check, deformable_min_track,
                                                 deformable_agreement_ratio, deformable_max_epipolar_ratio, starving_max_epipolar_ratio, deformable_min_parallax_px,

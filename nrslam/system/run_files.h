@@ -23,7 +23,7 @@ namespace nrslam {
 inline constexpr const char* kPointsCsvHeader = "frame,point_id,u,v,z_est,x,y,z,status";
 inline constexpr const char* kMetricsCsvHeader =
     "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,"
-    "deformable_candidates,new_points,points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,"
+    "deformable_candidates,new_points,new_point_depth_bias,batch_rejected,points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,"
     "ms_dba,ms_triangulation,ms_total,ms_joint_solve,ms_linear_solve,median_depth,note";
 
 // What the input did to a run, as the runner counts it in summary.json and the batch reads it
