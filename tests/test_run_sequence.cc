@@ -1079,10 +1079,13 @@ TEST(MonocularRun, StarvingMapDropsTheTwoRayCheck) {
   // Even over the shortest span, the tissue moves about as far as the camera, so many
   // candidates' rigid rays miss each other; a starving map (here: every frame, fraction 1)
   // gates on parallax alone and leaves the rest to the deformable fit's own checks.
-  // (The epipolar gate, which turns many of the same tracks away, is off in both runs.)
+  // (The epipolar gate, which turns many of the same tracks away, is off in both runs, and so
+  // is the batch depth check, which turns batches of these loosely gated points away and so
+  // changes which candidates later frames have.)
   SystemOptions checked, parallax_only;
   checked.mapping.shortest_gate_below_fraction = parallax_only.mapping.shortest_gate_below_fraction = 1;
   checked.mapping.starving_max_epipolar_ratio = parallax_only.mapping.starving_max_epipolar_ratio = 0;
+  checked.mapping.max_batch_depth_bias = parallax_only.mapping.max_batch_depth_bias = 0;
   checked.mapping.starving_two_ray_check = true;
   parallax_only.mapping.starving_two_ray_check = false;
   const MonocularOutcome reference = RunMonocular("sim-3", checked);

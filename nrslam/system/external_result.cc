@@ -365,7 +365,7 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
     const TrackingState state = tracked ? TrackingState::kTracking
                                 : summary.init_frame < 0 ? TrackingState::kNotInitialised
                                                          : TrackingState::kLost;
-    metrics_csv << frame << ',' << ToString(state) << ',' << summary.maps << ',' << points.size() << ",0,0,0,0,0,0,0,0,"
+    metrics_csv << frame << ',' << ToString(state) << ',' << summary.maps << ',' << points.size() << ",0,0,0,0,0,0,0,0,0,0,"
                 << frame_evaluation.points_without_groundtruth << ','
                 << (frame_evaluation.evaluated ? frame_evaluation.scale : 0.0) << ','
                 << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
