@@ -6,8 +6,10 @@
 // MappingOptions::dba_model_selection); its newest shape and pose go back to tracking. On other frames candidates are triangulated, rigidly and deformably, and the
 // paper's model selection keeps one set: the rigid points if there are more than
 // model_selection_factor × as many as deformable ones, the deformable points if there are at
-// least that many times more, else none. New points join the DDG, connected to every point
-// tracked this frame, and their 2D tracks become 3D tracks.
+// least that many times more, else none. A kept set that leans off the map as a whole (its
+// median depth against its points' neighbours: max_batch_depth_bias) is turned away. New
+// points join the DDG, connected to every point tracked this frame, and their 2D tracks
+// become 3D tracks.
 #pragma once
 
 #include <Eigen/Core>
