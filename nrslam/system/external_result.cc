@@ -362,19 +362,17 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
         }
       }
     }
-    const TrackingState state = tracked ? TrackingState::kTracking
-                                : summary.init_frame < 0 ? TrackingState::kNotInitialised
-                                                         : TrackingState::kLost;
-    metrics_csv << frame << ',' << ToString(state) << ',' << summary.maps << ',' << points.size() << ",0,0,0,0,0,0,0,0,0,0,"
-                << frame_evaluation.points_without_groundtruth << ','
-                << (frame_evaluation.evaluated ? frame_evaluation.scale : 0.0) << ','
-                << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.rmse_mm) : std::string()) << ','
-                << (frame_evaluation.evaluated ? std::to_string(frame_evaluation.flat_rmse_mm) : std::string())
-                << ",0,0,0,0,0,0,0,0,";
-    if (median_depth > 0) metrics_csv << median_depth;
-    metrics_csv << ','
-                << CsvField(!tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem)
-                << '\n';
+    MetricsRow row;
+    row.frame = frame;
+    row.state = tracked ? TrackingState::kTracking
+                : summary.init_frame < 0 ? TrackingState::kNotInitialised
+                                         : TrackingState::kLost;
+    row.map = summary.maps;
+    row.points = points.size();
+    row.Score(frame_evaluation);
+    row.median_depth = median_depth;
+    row.note = !tracked ? "no estimate" : depth_problem.empty() ? "" : "not scored: " + depth_problem;
+    WriteMetricsRow(metrics_csv, row);
     // Last used here, so its pairs move into the list kept for the alignments at the end.
     if (frame_evaluation.evaluated) evaluations.push_back(std::move(frame_evaluation));
   }

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "nrslam/io/depth_encoding.h"
+#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/folder.h"
 #include "nrslam/util/median.h"
@@ -256,6 +257,85 @@ void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& fram
   summary->trajectory_error = AlignedTrajectoryError(maps);
 }
 
+namespace {
+
+struct MetricsColumn {
+  const char* name;
+  void (*write)(std::ostream& out, const MetricsRow& row);
+};
+
+// metrics.csv's columns in their order. The RMSEs are at 6 decimals (std::to_string), as the
+// file has always held them, whatever the stream's precision.
+const MetricsColumn kMetricsColumns[] = {
+    {"frame", [](std::ostream& out, const MetricsRow& row) { out << row.frame; }},
+    {"state", [](std::ostream& out, const MetricsRow& row) { out << ToString(row.state); }},
+    {"map", [](std::ostream& out, const MetricsRow& row) { out << row.map; }},
+    {"points", [](std::ostream& out, const MetricsRow& row) { out << row.points; }},
+    {"klt_tracked", [](std::ostream& out, const MetricsRow& row) { out << row.klt_tracked; }},
+    {"candidates", [](std::ostream& out, const MetricsRow& row) { out << row.candidates; }},
+    {"outliers", [](std::ostream& out, const MetricsRow& row) { out << row.outliers; }},
+    {"propagated", [](std::ostream& out, const MetricsRow& row) { out << row.propagated; }},
+    {"reassociated", [](std::ostream& out, const MetricsRow& row) { out << row.reassociated; }},
+    {"rigid_candidates", [](std::ostream& out, const MetricsRow& row) { out << row.rigid_candidates; }},
+    {"deformable_candidates", [](std::ostream& out, const MetricsRow& row) { out << row.deformable_candidates; }},
+    {"new_points", [](std::ostream& out, const MetricsRow& row) { out << row.new_points; }},
+    {"new_point_depth_bias", [](std::ostream& out, const MetricsRow& row) { out << row.new_point_depth_bias; }},
+    {"batch_rejected", [](std::ostream& out, const MetricsRow& row) { out << (row.batch_rejected ? 1 : 0); }},
+    {"points_without_gt", [](std::ostream& out, const MetricsRow& row) { out << row.points_without_groundtruth; }},
+    {"scale", [](std::ostream& out, const MetricsRow& row) { out << (row.evaluated ? row.scale : 0.0); }},
+    {"rmse_mm",
+     [](std::ostream& out, const MetricsRow& row) {
+       if (row.evaluated) out << std::to_string(row.rmse_mm);
+     }},
+    {"rmse_flat_mm",
+     [](std::ostream& out, const MetricsRow& row) {
+       if (row.evaluated) out << std::to_string(row.flat_rmse_mm);
+     }},
+    {"ms_klt", [](std::ostream& out, const MetricsRow& row) { out << row.ms_klt; }},
+    {"ms_pose", [](std::ostream& out, const MetricsRow& row) { out << row.ms_pose; }},
+    {"ms_deformation", [](std::ostream& out, const MetricsRow& row) { out << row.ms_deformation; }},
+    {"ms_dba", [](std::ostream& out, const MetricsRow& row) { out << row.ms_dba; }},
+    {"ms_triangulation", [](std::ostream& out, const MetricsRow& row) { out << row.ms_triangulation; }},
+    {"ms_total", [](std::ostream& out, const MetricsRow& row) { out << row.ms_total; }},
+    {"ms_joint_solve", [](std::ostream& out, const MetricsRow& row) { out << row.ms_joint_solve; }},
+    {"ms_linear_solve", [](std::ostream& out, const MetricsRow& row) { out << row.ms_linear_solve; }},
+    // At the stream's 9 digits: a collapsed map's depths are tiny.
+    {"median_depth",
+     [](std::ostream& out, const MetricsRow& row) {
+       if (row.median_depth > 0) out << row.median_depth;
+     }},
+    {"note", [](std::ostream& out, const MetricsRow& row) { out << CsvField(row.note); }},
+};
+
+}  // namespace
+
+void MetricsRow::Score(const FrameEvaluation& evaluation) {
+  points_without_groundtruth = evaluation.points_without_groundtruth;
+  evaluated = evaluation.evaluated;
+  scale = evaluation.scale;
+  rmse_mm = evaluation.rmse_mm;
+  flat_rmse_mm = evaluation.flat_rmse_mm;
+}
+
+std::string MetricsCsvHeader() {
+  std::string header;
+  for (const MetricsColumn& column : kMetricsColumns) {
+    if (!header.empty()) header += ',';
+    header += column.name;
+  }
+  return header;
+}
+
+void WriteMetricsRow(std::ostream& out, const MetricsRow& row) {
+  bool first = true;
+  for (const MetricsColumn& column : kMetricsColumns) {
+    if (!first) out << ',';
+    first = false;
+    column.write(out, row);
+  }
+  out << '\n';
+}
+
 RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::filesystem::path& sequence,
                                 const nlohmann::json& config) {
   CreateFolder(out);
@@ -278,7 +358,7 @@ RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::fil
   }
   RunFolderStreams streams{OpenForWriting(out / "points.csv"), OpenForWriting(out / "metrics.csv")};
   streams.points << kPointsCsvHeader << '\n';
-  streams.metrics << kMetricsCsvHeader << '\n';
+  streams.metrics << MetricsCsvHeader() << '\n';
   return streams;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <map>
 #include <string>
 #include <utility>
@@ -17,14 +18,43 @@
 #include "nrslam/eval/birth_errors.h"
 #include "nrslam/eval/depth_evaluation.h"
 #include "nrslam/eval/trajectory_error.h"
+#include "nrslam/tracking/tracker.h"
 
 namespace nrslam {
 
 inline constexpr const char* kPointsCsvHeader = "frame,point_id,u,v,z_est,x,y,z,status";
-inline constexpr const char* kMetricsCsvHeader =
-    "frame,state,map,points,klt_tracked,candidates,outliers,propagated,reassociated,rigid_candidates,"
-    "deformable_candidates,new_points,new_point_depth_bias,batch_rejected,points_without_gt,scale,rmse_mm,rmse_flat_mm,ms_klt,ms_pose,ms_deformation,"
-    "ms_dba,ms_triangulation,ms_total,ms_joint_solve,ms_linear_solve,median_depth,note";
+
+// One frame's row of metrics.csv. The runner fills every field. The scorer of another system's
+// output knows only the state, the map, the points and what the evaluator made of them; it
+// leaves the tracker's and mapper's counts and timings at zero.
+struct MetricsRow {
+  int frame = 0;
+  TrackingState state = TrackingState::kNotInitialised;
+  int map = 0;
+  size_t points = 0;
+  int klt_tracked = 0;
+  size_t candidates = 0;
+  int outliers = 0, propagated = 0, reassociated = 0;
+  int rigid_candidates = 0, deformable_candidates = 0, new_points = 0;
+  double new_point_depth_bias = 0;  // MappingReport's
+  bool batch_rejected = false;
+  int points_without_groundtruth = 0;
+  bool evaluated = false;  // false: scale 0 and the two RMSEs left empty
+  double scale = 0, rmse_mm = 0, flat_rmse_mm = 0;
+  double ms_klt = 0, ms_pose = 0, ms_deformation = 0, ms_dba = 0, ms_triangulation = 0;
+  double ms_total = 0;  // tracking and mapping together
+  double ms_joint_solve = 0, ms_linear_solve = 0;
+  double median_depth = 0;  // map units; 0 (no points) is written empty
+  std::string note;
+
+  // The evaluator's figures for the frame.
+  void Score(const FrameEvaluation& evaluation);
+};
+
+// metrics.csv's header line and one row in its columns, numbers at the stream's precision.
+// Both come from one list of columns, so a column added to one is added to the other.
+std::string MetricsCsvHeader();
+void WriteMetricsRow(std::ostream& out, const MetricsRow& row);
 
 // What the input did to a run, as the runner counts it in summary.json and the batch reads it
 // back into results.json: files that could not be read, frames skipped or noted, ground truth

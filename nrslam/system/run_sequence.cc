@@ -21,7 +21,6 @@
 #include "nrslam/mapping/monocular_initialiser.h"
 #include "nrslam/system/static_regions.h"
 #include "nrslam/tracking/tracker.h"
-#include "nrslam/util/csv.h"
 #include "nrslam/util/error.h"
 #include "nrslam/util/memory_usage.h"
 #include "nrslam/util/stopwatch.h"
@@ -361,19 +360,33 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
                SplatDepth(depth_points, evaluation.evaluated ? evaluation.scale : 1.0, size, reader.info().depth_unit_mm));
     }
     summary.CountFrame(frame, tracked, result.note);
-    metrics_csv << frame << ',' << ToString(result.state) << ',' << maps << ',' << result.points.size() << ','
-                << result.klt_tracked << ',' << result.candidates.size() << ',' << result.outliers << ','
-                << result.propagated << ',' << result.reassociated << ',' << mapping.rigid_candidates << ','
-                << mapping.deformable_candidates << ',' << mapping.new_points << ',' << mapping.new_point_depth_bias << ','
-                << mapping.batch_rejected << ','
-                << evaluation.points_without_groundtruth << ',' << (evaluation.evaluated ? evaluation.scale : 0.0) << ','
-                << (evaluation.evaluated ? std::to_string(evaluation.rmse_mm) : std::string()) << ','
-                << (evaluation.evaluated ? std::to_string(evaluation.flat_rmse_mm) : std::string()) << ','
-                << result.ms_klt << ',' << result.ms_pose << ',' << result.ms_deformation << ',' << mapping.ms_dba << ','
-                << mapping.ms_triangulation << ',' << result.ms_total + mapping.ms_dba + mapping.ms_triangulation << ','
-                << result.ms_joint_solve << ',' << result.ms_linear_solve << ',';
-    if (median_depth > 0) metrics_csv << median_depth;  // at the file's 9 digits: a collapsed map's are tiny
-    metrics_csv << ',' << CsvField(result.note) << '\n';
+    MetricsRow row;
+    row.frame = frame;
+    row.state = result.state;
+    row.map = maps;
+    row.points = result.points.size();
+    row.klt_tracked = result.klt_tracked;
+    row.candidates = result.candidates.size();
+    row.outliers = result.outliers;
+    row.propagated = result.propagated;
+    row.reassociated = result.reassociated;
+    row.rigid_candidates = mapping.rigid_candidates;
+    row.deformable_candidates = mapping.deformable_candidates;
+    row.new_points = mapping.new_points;
+    row.new_point_depth_bias = mapping.new_point_depth_bias;
+    row.batch_rejected = mapping.batch_rejected;
+    row.Score(evaluation);
+    row.ms_klt = result.ms_klt;
+    row.ms_pose = result.ms_pose;
+    row.ms_deformation = result.ms_deformation;
+    row.ms_dba = mapping.ms_dba;
+    row.ms_triangulation = mapping.ms_triangulation;
+    row.ms_total = result.ms_total + mapping.ms_dba + mapping.ms_triangulation;
+    row.ms_joint_solve = result.ms_joint_solve;
+    row.ms_linear_solve = result.ms_linear_solve;
+    row.median_depth = median_depth;
+    row.note = result.note;
+    WriteMetricsRow(metrics_csv, row);
     // A full disk shows here within a few frames, not after the whole run.
     if (points_csv.fail() || metrics_csv.fail()) {
       throw Error("cannot write the run's files in " + out.string() + " (is the disk full?)");
