@@ -38,6 +38,7 @@
 #include "nrslam/sim/renderer.h"
 #include "nrslam/sim/simulate.h"
 #include "nrslam/system/external_result.h"
+#include "nrslam/system/run_files.h"
 #include "nrslam/system/run_sequence.h"
 #include "nrslam/system/static_regions.h"
 #include "nrslam/tracking/tracker.h"
@@ -243,6 +244,67 @@ TEST_F(RunSequenceTest, MedianDepthIsRecomputableFromPointsCsvAndFollowsTheTruth
   EXPECT_NEAR(summary.at("map_depth_change").get<double>(), recorded.at(39) / recorded.at(0), 1e-6);
   EXPECT_TRUE(summary.at("map_depth_change_beyond_from").is_null());
   EXPECT_EQ(summary_->map_depth.Note(), "");
+}
+
+// A metrics.csv row reads back under the header's names with what it was given: an
+// unscored frame leaves its RMSEs empty and its scale 0, a map with no points its median depth
+// empty, and a note with commas and quotes stays one field.
+TEST(MetricsCsv, ARowReadsBackUnderTheHeadersNames) {
+  const fs::path folder = UniqueTempFolder("metrics_row");
+  fs::create_directories(folder);
+  MetricsRow tracked;
+  tracked.frame = 7;
+  tracked.state = TrackingState::kTracking;
+  tracked.map = 2;
+  tracked.points = 151;
+  tracked.new_points = 12;
+  tracked.new_point_depth_bias = 1.31;
+  tracked.batch_rejected = true;
+  FrameEvaluation evaluation;
+  evaluation.evaluated = true;
+  evaluation.scale = 48.5;
+  evaluation.rmse_mm = 1.25;
+  evaluation.flat_rmse_mm = 3.5;
+  evaluation.points_without_groundtruth = 4;
+  tracked.Score(evaluation);
+  tracked.ms_total = 33.5;
+  tracked.median_depth = 1.75;
+  tracked.note = "view jump, \"12 px\"";
+  MetricsRow unscored;
+  unscored.frame = 8;
+  unscored.state = TrackingState::kLost;
+  evaluation.evaluated = false;
+  unscored.Score(evaluation);
+  {
+    std::ofstream file = OpenForWriting(folder / "metrics.csv");
+    file << MetricsCsvHeader() << '\n';
+    WriteMetricsRow(file, tracked);
+    WriteMetricsRow(file, unscored);
+  }
+  const auto rows = ReadCsv(folder / "metrics.csv");  // refuses a row whose fields miscount
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("frame"), "7");
+  EXPECT_EQ(rows[0].at("state"), "tracking");
+  EXPECT_EQ(rows[0].at("map"), "2");
+  EXPECT_EQ(rows[0].at("points"), "151");
+  EXPECT_EQ(rows[0].at("new_points"), "12");
+  EXPECT_EQ(rows[0].at("new_point_depth_bias"), "1.31");
+  EXPECT_EQ(rows[0].at("batch_rejected"), "1");
+  EXPECT_EQ(rows[0].at("points_without_gt"), "4");
+  EXPECT_EQ(rows[0].at("scale"), "48.5");
+  EXPECT_EQ(rows[0].at("rmse_mm"), "1.250000");
+  EXPECT_EQ(rows[0].at("rmse_flat_mm"), "3.500000");
+  EXPECT_EQ(rows[0].at("ms_total"), "33.5");
+  EXPECT_EQ(rows[0].at("median_depth"), "1.75");
+  EXPECT_EQ(rows[0].at("note"), "view jump, \"12 px\"");
+  EXPECT_EQ(rows[1].at("state"), "lost");
+  EXPECT_EQ(rows[1].at("scale"), "0");
+  EXPECT_EQ(rows[1].at("rmse_mm"), "");
+  EXPECT_EQ(rows[1].at("rmse_flat_mm"), "");
+  EXPECT_EQ(rows[1].at("median_depth"), "");
+  EXPECT_EQ(rows[1].at("batch_rejected"), "0");
+  EXPECT_EQ(rows[1].at("note"), "");
+  fs::remove_all(folder);
 }
 
 TEST(MapDepthDrift, IsTheChangeOfTheMapNotGivenUpThatMovedMost) {
