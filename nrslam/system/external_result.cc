@@ -339,15 +339,10 @@ RunSummary ScoreExternalResult(const fs::path& sequence, const ExternalResult& r
       }
       had_points = had_points || !points.empty();
       for (const EstimatedPoint& point : points) {
-        points_csv << frame << ',' << point.id << ',' << point.pixel.x << ',' << point.pixel.y << ',' << point.depth << ',';
         const Eigen::Vector3d ray = info.camera.Unproject(Eigen::Vector2d(point.pixel.x, point.pixel.y));
-        if (pose != poses.end() && ray.z() > 1e-9) {
-          const Eigen::Vector3d world = pose->second * (ray * (point.depth / ray.z()));
-          points_csv << world.x() << ',' << world.y() << ',' << world.z();
-        } else {
-          points_csv << ",,";  // no pose: no world position
-        }
-        points_csv << ",tracked\n";
+        std::optional<Eigen::Vector3d> world;  // none without a pose
+        if (pose != poses.end() && ray.z() > 1e-9) world = pose->second * (ray * (point.depth / ray.z()));
+        WritePointsRow(points_csv, frame, point.id, point.pixel, point.depth, world, "tracked");
       }
       const fs::path depth_file = out / "depth" / FrameFileName(frame);
       const double to_mm = frame_evaluation.evaluated ? frame_evaluation.scale : 1.0;

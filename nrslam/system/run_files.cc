@@ -257,6 +257,17 @@ void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& fram
   summary->trajectory_error = AlignedTrajectoryError(maps);
 }
 
+void WritePointsRow(std::ostream& out, int frame, int64_t id, const cv::Point2d& pixel, double depth,
+                    const std::optional<Eigen::Vector3d>& world, const char* status) {
+  out << frame << ',' << id << ',' << pixel.x << ',' << pixel.y << ',' << depth << ',';
+  if (world) {
+    out << world->x() << ',' << world->y() << ',' << world->z();
+  } else {
+    out << ",,";
+  }
+  out << ',' << status << '\n';
+}
+
 namespace {
 
 struct MetricsColumn {

@@ -1,16 +1,19 @@
 // system: the files of a run folder that every producer of one writes the same way (the
-// runner, and the scorer of another system's output): their CSV headers, the estimated depth
-// images, and summary.json with the run's aggregates and how it ended.
+// runner, and the scorer of another system's output): points.csv's and metrics.csv's headers
+// and rows, the estimated depth images, and summary.json with the run's aggregates and how it
+// ended.
 #pragma once
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <ostream>
 #include <map>
+#include <optional>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,6 +26,12 @@
 namespace nrslam {
 
 inline constexpr const char* kPointsCsvHeader = "frame,point_id,u,v,z_est,x,y,z,status";
+
+// One row of points.csv: a point's pixel and camera depth (z_est) on a frame, its world
+// position when the frame has a pose (else the three fields are empty), and its status
+// ("tracked", "reassociated").
+void WritePointsRow(std::ostream& out, int frame, int64_t id, const cv::Point2d& pixel, double depth,
+                    const std::optional<Eigen::Vector3d>& world, const char* status);
 
 // One frame's row of metrics.csv. The runner fills every field. The scorer of another system's
 // output knows only the state, the map, the points and what the evaluator made of them; it

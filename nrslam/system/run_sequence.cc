@@ -325,9 +325,8 @@ RunSummary RunSequence(const fs::path& sequence, const SystemOptions& options, c
         const double z = (result.cam_from_world * world).z();
         depth_points.push_back({cv::Point2d(point.pixel.x, point.pixel.y), z});
         ids.push_back(id_base + point.id);
-        points_csv << frame << ',' << ids.back() << ',' << point.pixel.x << ',' << point.pixel.y << ',' << z << ','
-                   << world.x() << ',' << world.y() << ',' << world.z() << ','
-                   << (point.reassociated ? "reassociated" : "tracked") << '\n';
+        WritePointsRow(points_csv, frame, ids.back(), point.pixel, z, world,
+                       point.reassociated ? "reassociated" : "tracked");
       }
       median_depth = MedianDepth(depth_points);
       const DepthChange map_depth = depth_drift.AddFrame(maps, frame, median_depth);
