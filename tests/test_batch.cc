@@ -133,6 +133,39 @@ TEST(Manifest, EachMistakeIsNamed) {
   std::filesystem::remove_all(folder);
 }
 
+// An unknown key gets what it most likely meant. A run option named as nrslam_run or --set names
+// it is shown under "set", where a manifest gives it; a mistake in "defaults" is reported there,
+// not against the first sequence that inherits it.
+TEST(Manifest, AnUnknownKeyGetsWhatItMostLikelyMeant) {
+  const auto folder = UniqueTempFolder("manifest_hints");
+  auto manifest = [&](const std::string& defaults, const std::string& sequence) {
+    return WriteFile(folder / "m.json", R"({"defaults": )" + defaults + R"(, "sequences": [)" + sequence + "]}");
+  };
+  const std::string preset = R"({"name": "a", "preset": "sim-0")";
+  EXPECT_NE(ErrorOf(manifest("{}", preset + R"(, "mapping": false})"))
+                .find(R"(sequence 1 ('a'): unknown key 'mapping': run options go under "set", as in "set": {"run.mapping": false})"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest("{}", preset + R"(, "max_degree_D": 4})")).find(R"("set": {"deformation.max_degree_D": 4})"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest("{}", preset + R"(, "rigd": true})")).find("unknown key 'rigd'; did you mean rigid?"),
+            std::string::npos);
+  const std::string colour = ErrorOf(manifest("{}", preset + R"(, "colour": 1})"));
+  EXPECT_NE(colour.find("unknown key 'colour'; known keys: camera, external, "), std::string::npos) << colour;
+  EXPECT_NE(colour.find(R"(; run options go under "set")"), std::string::npos) << colour;
+  const std::string in_defaults = ErrorOf(manifest(R"({"init": "depth", "no_mapping": true})", preset + "}"));
+  EXPECT_NE(in_defaults.find("m.json, defaults: unknown key 'no_mapping'; known keys: camera, external, first_frame, "
+                             "init, last_frame, rigid, set, simulate; run options go under \"set\""),
+            std::string::npos)
+      << in_defaults;
+  EXPECT_EQ(in_defaults.find("sequence 1"), std::string::npos) << in_defaults;
+  EXPECT_NE(ErrorOf(WriteFile(folder / "top.json", R"({"sequence": []})")).find("unknown key 'sequence'; did you mean sequences?"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(manifest("{}", R"({"name": "a", "import": {"format": "stereo", "path": "x", "depth_unit": 1}})"))
+                .find("import: unknown key 'depth_unit'; did you mean depth_unit_mm?"),
+            std::string::npos);
+  std::filesystem::remove_all(folder);
+}
+
 TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   const auto folder = UniqueTempFolder("manifest_ok");
   const Manifest manifest = LoadManifest(WriteFile(folder / "lists" / "m.json", R"({

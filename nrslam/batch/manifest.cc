@@ -3,7 +3,10 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <optional>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "nrslam/datasets/dataset_import.h"
 #include "nrslam/sim/sim_options.h"
@@ -14,6 +17,7 @@ namespace nrslam {
 
 namespace {
 
+const std::set<std::string> kManifestKeys = {"description", "defaults", "sequences"};
 // The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).
 const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "import", "simulate", "set", "init",
                                              "rigid", "first_frame", "last_frame", "camera", "external"};
@@ -29,6 +33,22 @@ const std::set<std::string> kImportKeys = {"format", "path", "calibration", "fps
 
 void Require(bool condition, const std::string& context, const std::string& message) {
   if (!condition) throw Error(context + ": " + message);
+}
+
+// Why `key` is refused, with what it most likely meant. Where run options are allowed (a sequence
+// entry, "defaults"), a run option's name, as --set takes it, is shown under "set", since the
+// manifest's keys and nrslam_run's flags are easily confused ("mapping", "k").
+std::string UnknownKey(const std::string& key, const Json& value, const std::set<std::string>& allowed,
+                       bool run_options_allowed) {
+  const std::vector<std::string> keys(allowed.begin(), allowed.end());
+  const std::string refused = "unknown key '" + key + "'";
+  if (!run_options_allowed) return refused + "; " + UnknownOptionHint(key, keys, "keys");
+  static const std::vector<std::string> run_options = LeafPaths(Json(SystemOptions{}));
+  const std::optional<std::string> option = FindOptionName(key, run_options);
+  if (option) return refused + ": run options go under \"set\", as in \"set\": {\"" + *option + "\": " + value.dump() + "}";
+  if (!CloseOptionNames(key, keys).empty()) return refused + "; " + UnknownOptionHint(key, keys, "keys");
+  return refused + "; known keys: " + Join(keys, ", ") +
+         "; run options go under \"set\", as in \"set\": {\"run.mapping\": false}";
 }
 
 // A path as the manifest gives it: relative ones are relative to the manifest's folder.
@@ -47,7 +67,7 @@ ExternalResult ParseExternal(const Json& entry, const std::filesystem::path& fol
           "\"external\" needs at least \"estimates\" (a CSV file or a folder of depth images)");
   ExternalResult result;
   for (const auto& [key, value] : external.items()) {
-    Require(kExternalKeys.count(key) > 0, context, "external: unknown key '" + key + "'");
+    Require(kExternalKeys.count(key) > 0, context, "external: " + UnknownKey(key, value, kExternalKeys, false));
     Require(key == "stride" ? value.is_number_integer() : value.is_string(), context,
             "external: \"" + key + "\" must be " + (key == "stride" ? "an integer" : "a string"));
   }
@@ -81,7 +101,7 @@ Json WithDefaults(const Json& defaults, const Json& entry) {
 ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& folder, const std::string& context) {
   Require(entry.is_object(), context, "each sequence must be a JSON object");
   for (const auto& [key, value] : entry.items()) {
-    Require(kSequenceKeys.count(key) > 0, context, "unknown key '" + key + "'");
+    Require(kSequenceKeys.count(key) > 0, context, UnknownKey(key, value, kSequenceKeys, true));
   }
   ManifestSequence sequence;
   Require(entry.contains("name") && entry["name"].is_string() && !entry["name"].get<std::string>().empty(), context,
@@ -98,7 +118,7 @@ ManifestSequence ParseSequence(const Json& entry, const std::filesystem::path& f
             context, "\"import\" needs at least \"format\" and \"path\"");
     Require(!entry.contains("simulate"), context, "\"simulate\" only applies to a preset");
     for (const auto& [key, value] : import.items()) {
-      Require(kImportKeys.count(key) > 0, context, "import: unknown key '" + key + "'");
+      Require(kImportKeys.count(key) > 0, context, "import: " + UnknownKey(key, value, kImportKeys, false));
       std::string text = value.is_string() ? value.get<std::string>() : value.dump();
       if (key == "path" || key == "calibration" || key == "mask" || key == "right" || key == "second_calibration") {
         text = FromManifest(text, folder).string();
@@ -202,8 +222,7 @@ Manifest LoadManifest(const std::filesystem::path& file) {
   }
   Require(json.is_object(), where, "must be a JSON object with a \"sequences\" list");
   for (const auto& [key, value] : json.items()) {
-    Require(key == "description" || key == "defaults" || key == "sequences", where,
-            "unknown key '" + key + "' (allowed: description, defaults, sequences)");
+    Require(kManifestKeys.count(key) > 0, where, UnknownKey(key, value, kManifestKeys, false));
   }
   Require(json.contains("sequences") && json["sequences"].is_array() && !json["sequences"].empty(), where,
           "needs a non-empty \"sequences\" list");
@@ -212,8 +231,14 @@ Manifest LoadManifest(const std::filesystem::path& file) {
   manifest.description = json.value("description", "");
   const Json defaults = json.value("defaults", Json::object());
   Require(defaults.is_object(), where, "\"defaults\" must be an object");
+  std::set<std::string> default_keys = kSequenceKeys;
   for (const char* key : {"name", "path", "preset", "import"}) {
     Require(!defaults.contains(key), where, std::string("\"defaults\" cannot hold \"") + key + "\"");
+    default_keys.erase(key);
+  }
+  // Checked here, or a mistake in them would be reported against the first sequence.
+  for (const auto& [key, value] : defaults.items()) {
+    Require(default_keys.count(key) > 0, where + ", defaults", UnknownKey(key, value, default_keys, true));
   }
   std::set<std::string> names;
   const auto& entries = json["sequences"];

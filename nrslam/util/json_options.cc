@@ -173,7 +173,7 @@ std::vector<std::string> LeafPaths(const Json& config) {
 
 std::string LastName(const std::string& path) { return path.substr(path.rfind('.') + 1); }  // npos + 1 == 0
 
-std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths) {
+std::vector<std::string> CloseOptionNames(const std::string& name, const std::vector<std::string>& paths) {
   const std::string wanted = LastName(name);
   // Short names allow fewer edits: two edits rewrite most of a short name.
   const size_t max_edits = wanted.size() < 3 ? 0 : wanted.size() < 8 ? 1 : 2;
@@ -183,7 +183,13 @@ std::string UnknownOptionHint(const std::string& name, const std::vector<std::st
     const bool contains = !wanted.empty() && candidate.find(wanted) != std::string::npos;
     if (contains || EditDistance(wanted, candidate) <= max_edits) close.push_back(path);
   }
-  if (close.empty()) return "known options: " + Join(paths, ", ");
+  return close;
+}
+
+std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths,
+                              const std::string& kind) {
+  std::vector<std::string> close = CloseOptionNames(name, paths);
+  if (close.empty()) return "known " + kind + ": " + Join(paths, ", ");
   const std::string last = close.back();
   close.pop_back();
   return "did you mean " + (close.empty() ? last : Join(close, ", ") + " or " + last) + "?";

@@ -47,12 +47,15 @@ std::vector<std::string> LeafPaths(const Json& config);
 // The last part of a dotted option path ("amplitude_mm"); the path itself when it has no dot.
 std::string LastName(const std::string& path);
 
-// What an error says after "unknown option 'name'": the options the name most likely meant
-// ("did you mean a or b?"), which are those whose last part contains the name's last part
-// ("sigma" finds every *sigma* option) or is within a few typing edits of it (two for a long
-// name: "stretch_treshold"; none under 3 characters); when none is that close, "known
-// options: " and all of them.
-std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths);
+// The options a mistyped name most likely meant: those whose last part contains the name's last
+// part ("sigma" finds every *sigma* option) or is within a few typing edits of it (two for a
+// long name: "stretch_treshold"; none under 3 characters). Empty when none is that close.
+std::vector<std::string> CloseOptionNames(const std::string& name, const std::vector<std::string>& paths);
+
+// What an error says after "unknown option 'name'": "did you mean a or b?" with the
+// CloseOptionNames, or when there are none "known <kind>: " and all of `paths`.
+std::string UnknownOptionHint(const std::string& name, const std::vector<std::string>& paths,
+                              const std::string& kind = "options");
 
 // `name` as one of `paths`: the path itself, or the only path whose last part it is ("k" for
 // "deformation.k"); nothing when no path or several match.
