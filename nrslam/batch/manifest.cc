@@ -43,8 +43,7 @@ std::string UnknownKey(const std::string& key, const Json& value, const std::set
   const std::vector<std::string> keys(allowed.begin(), allowed.end());
   const std::string refused = "unknown key '" + key + "'";
   if (!run_options_allowed) return refused + "; " + UnknownOptionHint(key, keys, "keys");
-  static const std::vector<std::string> run_options = LeafPaths(Json(SystemOptions{}));
-  const std::optional<std::string> option = FindOptionName(key, run_options);
+  const std::optional<std::string> option = FindOptionName(key, RunOptionPaths());
   if (option) return refused + ": run options go under \"set\", as in \"set\": {\"" + *option + "\": " + value.dump() + "}";
   if (!CloseOptionNames(key, keys).empty()) return refused + "; " + UnknownOptionHint(key, keys, "keys");
   return refused + "; known keys: " + Join(keys, ", ") +

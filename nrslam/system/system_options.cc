@@ -33,10 +33,12 @@ std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options) {
   return ChangedAssignments(Json(SystemOptions{}), Json(options));
 }
 
-std::string ResolveRunOption(const std::string& name) {
+const std::vector<std::string>& RunOptionPaths() {
   static const std::vector<std::string> paths = LeafPaths(Json(SystemOptions{}));
-  return ResolveOptionName(name, paths, "option");
+  return paths;
 }
+
+std::string ResolveRunOption(const std::string& name) { return ResolveOptionName(name, RunOptionPaths(), "option"); }
 
 std::string ResolveRunAssignment(const std::string& assignment) {
   const size_t equals = assignment.find('=');

@@ -69,6 +69,8 @@ SystemOptions SystemOptionsFromFile(const std::filesystem::path& file);
 // give `options` back. How a file's configuration joins a batch's --set list.
 std::vector<std::string> AssignmentsOverDefaults(const SystemOptions& options);
 
+// Every run option's full path ("deformation.k"), in config.json's order.
+const std::vector<std::string>& RunOptionPaths();
 // A run option's full path from a full path or a unique last name ("k" → "deformation.k");
 // throws Error listing the candidates when unknown or ambiguous.
 std::string ResolveRunOption(const std::string& name);
