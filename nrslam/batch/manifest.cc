@@ -18,7 +18,7 @@ namespace nrslam {
 namespace {
 
 const std::set<std::string> kManifestKeys = {"description", "defaults", "sequences"};
-// The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset).
+// The allowed keys of a sequence entry (and of "defaults", which has no name/path/preset/import).
 const std::set<std::string> kSequenceKeys = {"name", "path", "preset", "import", "simulate", "set", "init",
                                              "rigid", "first_frame", "last_frame", "camera", "external"};
 // The keys that configure an NR-SLAM run, which an external result does not have.
@@ -40,14 +40,19 @@ void Require(bool condition, const std::string& context, const std::string& mess
 // manifest's keys and nrslam_run's flags are easily confused ("mapping", "k").
 std::string UnknownKey(const std::string& key, const Json& value, const std::set<std::string>& allowed,
                        bool run_options_allowed) {
-  const std::vector<std::string> keys(allowed.begin(), allowed.end());
   const std::string refused = "unknown key '" + key + "'";
-  if (!run_options_allowed) return refused + "; " + UnknownOptionHint(key, keys, "keys");
-  const std::optional<std::string> option = FindOptionName(key, RunOptionPaths());
-  if (option) return refused + ": run options go under \"set\", as in \"set\": {\"" + *option + "\": " + value.dump() + "}";
-  if (!CloseOptionNames(key, keys).empty()) return refused + "; " + UnknownOptionHint(key, keys, "keys");
-  return refused + "; known keys: " + Join(keys, ", ") +
-         "; run options go under \"set\", as in \"set\": {\"run.mapping\": false}";
+  if (run_options_allowed) {
+    if (const std::optional<std::string> option = FindOptionName(key, RunOptionPaths())) {
+      return refused + ": run options go under \"set\", as in \"set\": {\"" + *option + "\": " + value.dump() + "}";
+    }
+  }
+  const std::vector<std::string> keys(allowed.begin(), allowed.end());
+  std::string message = refused + "; " + UnknownOptionHint(key, keys, "keys");
+  // Nothing close: the key may be a run option under another name ("no_mapping").
+  if (run_options_allowed && CloseOptionNames(key, keys).empty()) {
+    message += "; run options go under \"set\", as in \"set\": {\"run.mapping\": false}";
+  }
+  return message;
 }
 
 // A path as the manifest gives it: relative ones are relative to the manifest's folder.
