@@ -480,6 +480,13 @@ TEST(CameraCheck, RejectsWrongCalibrations) {
   EXPECT_NE(message(Camera::Pinhole(640, 480, 3000, 300, 320, 240)).find("differ by more than 4 times"),
             std::string::npos);
   EXPECT_EQ(message(Camera::Pinhole(720, 288, 800, 400, 360, 144)), "");  // an interlaced field
+  // Intrinsics normalised by the image size, or a focal length in mm: a view no lens gives.
+  EXPECT_NE(message(Camera::Pinhole(640, 480, 0.8, 1.07, 320, 240)).find("under 1/20 of the 640x480 image"),
+            std::string::npos);
+  EXPECT_NE(message(Camera::KannalaBrandt(640, 480, 3.2, 3.2, 320, 240, Eigen::Vector4d::Zero())).find("under 1/20"),
+            std::string::npos);
+  EXPECT_EQ(message(Camera::KannalaBrandt(640, 480, 110, 110, 320, 240, Eigen::Vector4d::Zero())), "")
+      << "a 235-degree fisheye whose image circle fits the image's height";
   EXPECT_NE(message(Camera::KannalaBrandt(640, 480, 300, 300, 320, 240, Eigen::Vector4d(-5, 0, 0, 0))).find("fold"),
             std::string::npos);
   // Coefficients that pass the fold-back test but squeeze the image into a hundredth of a degree.
@@ -494,6 +501,35 @@ TEST(CameraCheck, RejectsWrongCalibrations) {
   EXPECT_THROW((nlohmann::json{{"model", "orthographic"}, {"width", 1}, {"height", 1}, {"fx", 1}, {"fy", 1},
                                 {"cx", 0}, {"cy", 0}}.get<Camera>()),
                Error);
+}
+
+TEST(CameraJson, AKeyTheModelDoesNotReadIsRefusedNotPassedOver) {
+  const auto message = [](const std::function<void(nlohmann::json&)>& change) {
+    nlohmann::json json = Pinhole();
+    change(json);
+    try {
+      json.get<Camera>();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message([](nlohmann::json&) {}), "");
+  // Before, each of these was read as the plain pinhole camera, the lens or skew ignored.
+  EXPECT_EQ(message([](nlohmann::json& j) { j["distortion"] = {-0.3, 0.1, 0, 0}; }),
+            "camera: model pinhole takes no 'distortion'; model opencv does (docs/data.md, \"Sequence format\")");
+  EXPECT_EQ(message([](nlohmann::json& j) { j["k"] = {0.01, 0, 0, 0}; }),
+            "camera: model pinhole takes no 'k'; model kannala_brandt does (docs/data.md, \"Sequence format\")");
+  EXPECT_EQ(message([](nlohmann::json& j) { j["skew"] = 0.5; }),
+            "camera (model pinhole): unknown key 'skew'; known keys: model, width, height, cx, cy, fx, fy");
+  EXPECT_EQ(message([](nlohmann::json& j) {
+              j["model"] = "opencv";
+              j["distortion"] = {0, 0, 0, 0};
+              j["distorsion"] = {0, 0, 0, 0};
+            }),
+            "camera (model opencv): unknown key 'distorsion'; did you mean distortion?");
+  EXPECT_EQ(message([](nlohmann::json& j) { j["model"] = "fisheye"; }),
+            "camera: unknown camera model 'fisheye' (known: pinhole, kannala_brandt, opencv, ocam)");
 }
 
 }  // namespace

@@ -157,6 +157,19 @@ TEST_F(SequenceReaderTest, FieldsOfAnotherKindAreNamedNotTruncated) {
   EXPECT_ERROR_MENTIONS("sequence.json: stereo: baseline_mm must be a number, got \"5\"");
 }
 
+TEST_F(SequenceReaderTest, AMisspeltKeyIsRefusedNotLeftToItsDefault) {
+  // Before, "depth_unit" was passed over and depth read in the default 0.01 mm units.
+  RewriteJson([](nlohmann::json& j) {
+    j["depth_unit"] = j["depth_unit_mm"];
+    j.erase("depth_unit_mm");
+  });
+  EXPECT_ERROR_MENTIONS("sequence.json: unknown key 'depth_unit'; did you mean depth_unit_mm?");
+  RewriteJson([](nlohmann::json& j) { j["stereo"] = {{"baseline", 5.0}}; });
+  EXPECT_ERROR_MENTIONS("sequence.json: stereo: unknown key 'baseline'; did you mean baseline_mm?");
+  RewriteJson([](nlohmann::json& j) { j["camera"]["distortion"] = {-0.3, 0.1, 0, 0}; });
+  EXPECT_ERROR_MENTIONS("camera: model pinhole takes no 'distortion'; model opencv does");
+}
+
 TEST_F(SequenceReaderTest, AnotherFormatOrALaterVersionIsRefused) {
   RewriteJson([](nlohmann::json& j) { j["format"] = "tum-rgbd"; });
   EXPECT_ERROR_MENTIONS("sequence.json: format is 'tum-rgbd', not 'nrslam-sequence'");

@@ -14,6 +14,7 @@
 
 #include "nrslam/util/error.h"
 #include "nrslam/util/json_options.h"
+#include "nrslam/util/text_table.h"
 
 namespace nrslam {
 
@@ -299,6 +300,16 @@ void Camera::Check() const {
          << "image size or unit?";
     fail(text.str());
   }
+  // The other way: at a twentieth of the image's width, even an equidistant lens that sees all
+  // around (f = width / 2π) would put the image's sides beyond its view. Focal lengths this small
+  // are normalised by the image size, or in mm.
+  constexpr double kMinFocalInImageSizes = 1.0 / 20;
+  if (focal_lengths && (fx() < kMinFocalInImageSizes * width_ || fy() < kMinFocalInImageSizes * height_)) {
+    text << "focal length fx=" << fx() << ", fy=" << fy() << " px is under 1/20 of the " << width_ << "x"
+         << height_ << " image, a wider view than any lens gives: intrinsics normalised by the image size, or in "
+         << "mm rather than px?";
+    fail(text.str());
+  }
   if (focal_lengths && std::max(fx() / fy(), fy() / fx()) > kMaxPixelAspect) {
     text << "fx=" << fx() << " and fy=" << fy() << " differ by more than " << kMaxPixelAspect << " times";
     fail(text.str());
@@ -419,11 +430,45 @@ void to_json(nlohmann::json& j, const Camera& camera) {
   }
 }
 
+namespace {
+
+// Throws Error for a key the model does not read. A key another model reads is named as such:
+// a pinhole camera given "distortion" would otherwise lose its lens model without a word.
+void RejectKeysOfOtherModels(const nlohmann::json& j, const std::string& model) {
+  const std::vector<std::string> common = {"model", "width", "height", "cx", "cy"};
+  const std::vector<std::pair<std::string, std::vector<std::string>>> model_keys = {
+      {PinholeModel::kName, {"fx", "fy"}},
+      {KannalaBrandtModel::kName, {"fx", "fy", "k"}},
+      {OpenCvModel::kName, {"fx", "fy", "distortion"}},
+      {OcamModel::kName, {"c", "d", "e", "ss", "invpol"}}};
+  std::vector<std::string> known = common, names;
+  for (const auto& [name, keys] : model_keys) {
+    names.push_back(name);
+    if (name == model) known.insert(known.end(), keys.begin(), keys.end());
+  }
+  if (known.size() == common.size()) {
+    throw Error("camera: unknown camera model '" + model + "' (known: " + Join(names, ", ") + ")");
+  }
+  for (const auto& item : j.items()) {
+    if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
+    for (const auto& [name, keys] : model_keys) {
+      if (std::find(keys.begin(), keys.end(), item.key()) != keys.end()) {
+        throw Error("camera: model " + model + " takes no '" + item.key() + "'; model " + name +
+                    " does (docs/data.md, \"Sequence format\")");
+      }
+    }
+  }
+  RejectUnknownKeys(j, known, "camera (model " + model + ")");
+}
+
+}  // namespace
+
 void from_json(const nlohmann::json& j, Camera& camera) {
   if (!j.is_object()) throw Error("camera: expected a JSON object");
   const auto number = [&](const char* key) { return Field<double>(j, key, "camera"); };
   const auto numbers = [&](const char* key) { return Field<std::vector<double>>(j, key, "camera"); };
   const std::string model = Field<std::string>(j, "model", "camera");
+  RejectKeysOfOtherModels(j, model);
   const int width = Field<int>(j, "width", "camera");
   const int height = Field<int>(j, "height", "camera");
   const double cx = number("cx"), cy = number("cy");
@@ -446,8 +491,6 @@ void from_json(const nlohmann::json& j, Camera& camera) {
       throw Error("camera: opencv needs 'distortion': OpenCV's distCoeffs, k1 k2 p1 p2 [k3 [k4 k5 k6]]");
     }
     camera = Camera::OpenCv(width, height, number("fx"), number("fy"), cx, cy, numbers("distortion"));
-  } else {
-    throw Error("camera: unknown camera model '" + model + "' (known: pinhole, kannala_brandt, opencv, ocam)");
   }
   camera.Check();
 }

@@ -60,6 +60,9 @@ void from_json(const nlohmann::json& j, SequenceInfo& info) {
     throw Error("sequence.json: version " + std::to_string(version) + " is newer than this nrslam reads (" +
                 std::to_string(kSequenceVersion) + ")");
   }
+  RejectUnknownKeys(j, {"format", "version", "camera", "fps", "frame_count", "depth_unit_mm", "mask", "stereo",
+                        "provenance"},
+                    "sequence.json");
   if (!j.contains("camera")) throw Error("sequence.json: missing field 'camera'");
   info.camera = j.at("camera").get<Camera>();
   info.fps = Field<double>(j, "fps", "sequence.json");
@@ -71,6 +74,7 @@ void from_json(const nlohmann::json& j, SequenceInfo& info) {
   if (j.contains("stereo")) {
     const nlohmann::json& stereo = j.at("stereo");
     if (!stereo.is_object()) throw Error("sequence.json: stereo must be a group, got " + stereo.dump());
+    RejectUnknownKeys(stereo, {"baseline_mm", "right_camera"}, "sequence.json: stereo");
     StereoInfo stereo_info;
     stereo_info.baseline_mm = Field<double>(stereo, "baseline_mm", "sequence.json: stereo");
     stereo_info.right_camera = stereo.contains("right_camera") ? stereo.at("right_camera").get<Camera>() : info.camera;

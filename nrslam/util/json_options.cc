@@ -195,6 +195,14 @@ std::string UnknownOptionHint(const std::string& name, const std::vector<std::st
   return "did you mean " + (close.empty() ? last : Join(close, ", ") + " or " + last) + "?";
 }
 
+void RejectUnknownKeys(const Json& object, const std::vector<std::string>& known, const std::string& context) {
+  for (const auto& item : object.items()) {
+    if (std::find(known.begin(), known.end(), item.key()) == known.end()) {
+      throw Error(context + ": unknown key '" + item.key() + "'; " + UnknownOptionHint(item.key(), known, "keys"));
+    }
+  }
+}
+
 namespace {
 
 std::vector<std::string> PathsWithLastName(const std::string& name, const std::vector<std::string>& paths) {

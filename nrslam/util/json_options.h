@@ -75,6 +75,11 @@ T Field(const Json& object, const std::string& key, const std::string& context, 
   return object.contains(key) ? Field<T>(object, key, context) : fallback;
 }
 
+// Throws Error "<context>: unknown key 'name'; did you mean …?" (or the known keys) for the first
+// key of `object` not in `known`. For files a person writes, such as sequence.json, where a
+// misspelt key would otherwise be passed over and its default used without a word.
+void RejectUnknownKeys(const Json& object, const std::vector<std::string>& known, const std::string& context);
+
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
 // rejecting unknown keys and values of the wrong kind, then Check()s.
 template <typename Options>
