@@ -40,6 +40,15 @@
 
 namespace {
 
+// CLI11's NonNegativeNumber names its upper bound, the largest double, in full (300 digits).
+const CLI::Validator kNonNegative(
+    [](std::string& text) -> std::string {
+      double value = -1;
+      if (CLI::detail::lexical_cast(text, value) && value >= 0) return "";
+      return "must be a number >= 0, got " + text;
+    },
+    "NONNEGATIVE");
+
 // The sibling programs, from this executable's own folder.
 nrslam::Programs SiblingPrograms() {
   std::error_code error;
@@ -162,12 +171,12 @@ int main(int argc, char** argv) {
   app.add_option("--write-baseline", write_baseline, "write the results as a baseline file");
   app.add_option("--tolerance", tolerance.rmse_relative, "relative RMSE growth per run a written baseline allows")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--pooled-tolerance", tolerance.pooled_rmse_relative,
                  "relative growth of the geometric mean RMSE ratio over all runs a written baseline allows; 0: no "
                  "such check (for chaotic runs: a loose --tolerance per run and a tight one over many runs)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   CLI::App* merge = app.add_subcommand("merge", "aggregate result folders (their run folders) into --out");
   merge->fallthrough();  // --out, --set, --sweep, --check-baseline given after "merge" too
   std::vector<std::string> merge_folders;
