@@ -1415,6 +1415,13 @@ TEST(RunSequenceErrors, BadInputGivesOneClearError) {
   const fs::path folder = UniqueTempFolder("nrslam_no_depth");
   fs::remove_all(folder);
   SimulateSmall("sim-0", 2, 64, 48, folder);
+  // Given the sequence's own folder as the run folder, the run would have replaced the ground
+  // truth in depth/ with its estimates (it did, before the check).
+  const std::string sequence_depth = FileText(folder / "depth" / FrameFileName(1));
+  EXPECT_EQ(ErrorMessage([&] { RunSequence(folder, SystemOptions{}, folder); }),
+            folder.string() + " holds a sequence (sequence.json): a run written there would replace its depth/ with "
+                              "the run's estimates; write the run to another folder");
+  EXPECT_EQ(FileText(folder / "depth" / FrameFileName(1)), sequence_depth);
   fs::remove_all(folder / "depth");
   try {
     RunSequence(folder, TrackingExperiment(), folder / "run");

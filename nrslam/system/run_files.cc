@@ -349,6 +349,12 @@ void WriteMetricsRow(std::ostream& out, const MetricsRow& row) {
 
 RunFolderStreams BeginRunFolder(const std::filesystem::path& out, const std::filesystem::path& sequence,
                                 const nlohmann::json& config) {
+  // A sequence's own folder (`--out` given the sequence's path, say) would have its ground-truth
+  // depth/ replaced by the run's estimates.
+  if (std::filesystem::exists(out / "sequence.json")) {
+    throw Error(out.string() + " holds a sequence (sequence.json): a run written there would replace its depth/ "
+                "with the run's estimates; write the run to another folder");
+  }
   CreateFolder(out);
   std::error_code error;
   // An earlier run's output in the same folder goes first, its summary before anything else: a

@@ -253,7 +253,7 @@ void AggregateInto(RunSummary* summary, const std::vector<FrameEvaluation>& fram
 // A run folder begun: an earlier run's files in `out` removed (summary.json first; other
 // files are left alone), `out` and `out`/depth created, config.json written (the version, the
 // sequence's absolute path, then `config`'s keys), points.csv and metrics.csv opened with
-// their headers. Throws Error if any of it cannot be written.
+// their headers. Throws Error if any of it cannot be written, or if `out` holds a sequence.
 struct RunFolderStreams {
   std::ofstream points, metrics;
 };
