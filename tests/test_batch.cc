@@ -337,6 +337,10 @@ TEST(Sweep, GridOverOptionsWithOneFolderPerPoint) {
   };
   refused({ParseSweep("k=1,2,1")}, "deformation.k: value 1 is given twice");
   refused({ParseSweep("k=1"), ParseSweep("deformation.k=2")}, "deformation.k is swept twice");
+  // Set and swept on one command line: the sweep would win in every run, without a word before.
+  ExpectRefused([] { RejectSetAndSwept({ResolveRunAssignment("k=2")}, {ParseSweep("deformation.k=1,3")}); },
+                "--set deformation.k=2 and --sweep deformation.k: the sweep would set it in every run; give one of them");
+  RejectSetAndSwept({ResolveRunAssignment("sigma_factor=2")}, {ParseSweep("k=1,3")});
   // Two options with one last name would label their runs alike.
   refused({ParseSweep("tracking.min_points=10"), ParseSweep("initialisation.min_points=50")},
           "two swept options are named 'min_points'");

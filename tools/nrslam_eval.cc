@@ -239,7 +239,10 @@ int main(int argc, char** argv) {
     for (const std::string& sweep : sweeps) grid.push_back(nrslam::ParseSweep(sweep));
     std::vector<std::string> resolved;
     if (!config_path.empty()) resolved = nrslam::AssignmentsOverDefaults(nrslam::SystemOptionsFromFile(config_path));
-    for (const std::string& assignment : assignments) resolved.push_back(nrslam::ResolveRunAssignment(assignment));
+    std::vector<std::string> set;
+    for (const std::string& assignment : assignments) set.push_back(nrslam::ResolveRunAssignment(assignment));
+    nrslam::RejectSetAndSwept(set, grid);
+    resolved.insert(resolved.end(), set.begin(), set.end());
     // Before any run: a baseline that cannot be read, or written, would otherwise fail only
     // after the whole evaluation.
     std::optional<nrslam::Json> baseline;

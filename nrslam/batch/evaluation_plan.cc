@@ -180,6 +180,17 @@ std::string LabelFolderName(const std::string& label) {
 
 }  // namespace
 
+void RejectSetAndSwept(const std::vector<std::string>& set_assignments, const std::vector<Sweep>& sweeps) {
+  for (const std::string& assignment : set_assignments) {
+    const std::string path = assignment.substr(0, assignment.find('='));
+    for (const Sweep& sweep : sweeps) {
+      if (sweep.path == path) {
+        throw Error("--set " + assignment + " and --sweep " + path + ": the sweep would set it in every run; give one of them");
+      }
+    }
+  }
+}
+
 std::string RunName(const std::string& sequence, const std::string& label) {
   return label.empty() ? sequence : sequence + " [" + label + "]";
 }

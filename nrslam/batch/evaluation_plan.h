@@ -23,6 +23,10 @@ struct Sweep {
 // Parses "name=v1,v2,v3" (name as for ResolveRunOption, or "simulate." and a simulator option
 // by its path or unique last name); throws Error when malformed or unknown.
 Sweep ParseSweep(const std::string& text);
+// Throws Error when an option of the command line's --set list (resolved "path=value") is also
+// swept: the sweep would set it in every run, so one of the two is a mistake. (A --config file's
+// value under a sweep is not: the file is the base the sweep varies.)
+void RejectSetAndSwept(const std::vector<std::string>& set_assignments, const std::vector<Sweep>& sweeps);
 // Whether a sweep point's "path=value" sets a simulator option ("simulate.…").
 bool IsSimulatorAssignment(const std::string& assignment);
 // Such an assignment as nrslam_simulate --set takes it: "simulate.deformation.amplitude_mm=5"
