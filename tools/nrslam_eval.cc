@@ -11,6 +11,8 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <cmath>
+#include <cstdlib>
 #include <csignal>
 #include <iostream>
 #include <optional>
@@ -43,8 +45,9 @@ namespace {
 // CLI11's NonNegativeNumber names its upper bound, the largest double, in full (300 digits).
 const CLI::Validator kNonNegative(
     [](std::string& text) -> std::string {
-      double value = -1;
-      if (CLI::detail::lexical_cast(text, value) && value >= 0) return "";
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (!text.empty() && *end == '\0' && std::isfinite(value) && value >= 0) return "";
       return "must be a number >= 0, got " + text;
     },
     "NONNEGATIVE");

@@ -434,7 +434,7 @@ namespace {
 
 // Throws Error for a key the model does not read. A key another model reads is named as such:
 // a pinhole camera given "distortion" would otherwise lose its lens model without a word.
-void RejectKeysOfOtherModels(const nlohmann::json& j, const std::string& model) {
+void RejectKeysTheModelDoesNotRead(const nlohmann::json& j, const std::string& model) {
   const std::vector<std::string> common = {"model", "width", "height", "cx", "cy"};
   const std::vector<std::pair<std::string, std::vector<std::string>>> model_keys = {
       {PinholeModel::kName, {"fx", "fy"}},
@@ -468,7 +468,7 @@ void from_json(const nlohmann::json& j, Camera& camera) {
   const auto number = [&](const char* key) { return Field<double>(j, key, "camera"); };
   const auto numbers = [&](const char* key) { return Field<std::vector<double>>(j, key, "camera"); };
   const std::string model = Field<std::string>(j, "model", "camera");
-  RejectKeysOfOtherModels(j, model);
+  RejectKeysTheModelDoesNotRead(j, model);
   const int width = Field<int>(j, "width", "camera");
   const int height = Field<int>(j, "height", "camera");
   const double cx = number("cx"), cy = number("cy");
