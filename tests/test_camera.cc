@@ -529,7 +529,14 @@ TEST(CameraJson, AKeyTheModelDoesNotReadIsRefusedNotPassedOver) {
             }),
             "camera (model opencv): unknown key 'distorsion'; did you mean distortion?");
   EXPECT_EQ(message([](nlohmann::json& j) { j["model"] = "fisheye"; }),
-            "camera: unknown camera model 'fisheye' (known: pinhole, kannala_brandt, opencv, ocam)");
+            "camera: unknown camera model 'fisheye' (known: pinhole, kannala_brandt, opencv, ocam); fisheye is "
+            "kannala_brandt here");
+  EXPECT_EQ(message([](nlohmann::json& j) { j["model"] = "perspective"; }),
+            "camera: unknown camera model 'perspective' (known: pinhole, kannala_brandt, opencv, ocam)");
+  // Coefficients one key each, as many calibration files write them, with any model.
+  EXPECT_EQ(message([](nlohmann::json& j) { j["k1"] = -0.2; }),
+            "camera: unknown key 'k1': lens coefficients go in one list, \"distortion\": [k1, k2, p1, p2, k3] with "
+            "model opencv (OpenCV's order), or \"k\": [k0, k1, k2, k3] with model kannala_brandt");
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <iomanip>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <set>
 #include <utility>
 #include <sstream>
 
@@ -447,10 +449,24 @@ void RejectKeysTheModelDoesNotRead(const nlohmann::json& j, const std::string& m
     if (name == model) known.insert(known.end(), keys.begin(), keys.end());
   }
   if (known.size() == common.size()) {
-    throw Error("camera: unknown camera model '" + model + "' (known: " + Join(names, ", ") + ")");
+    // The names calibration tools give these models (Kalibr, ROS, OpenCV's fisheye module).
+    const std::map<std::string, std::string> other_names = {
+        {"radtan", OpenCvModel::kName},          {"plumb_bob", OpenCvModel::kName},
+        {"rational_polynomial", OpenCvModel::kName}, {"equidistant", KannalaBrandtModel::kName},
+        {"fisheye", KannalaBrandtModel::kName},   {"omni", OcamModel::kName}};
+    const auto other = other_names.find(model);
+    throw Error("camera: unknown camera model '" + model + "' (known: " + Join(names, ", ") + ")" +
+                (other == other_names.end() ? "" : "; " + model + " is " + other->second + " here"));
   }
   for (const auto& item : j.items()) {
     if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
+    // Lens coefficients one key each, as many calibration files write them.
+    const std::set<std::string> coefficients = {"k1", "k2", "k3", "k4", "k5", "k6", "p1", "p2"};
+    if (coefficients.count(item.key()) > 0) {
+      throw Error("camera: unknown key '" + item.key() + "': lens coefficients go in one list, \"distortion\": [k1, k2, "
+                  "p1, p2, k3] with model opencv (OpenCV's order), or \"k\": [k0, k1, k2, k3] with model "
+                  "kannala_brandt");
+    }
     for (const auto& [name, keys] : model_keys) {
       if (std::find(keys.begin(), keys.end(), item.key()) != keys.end()) {
         throw Error("camera: model " + model + " takes no '" + item.key() + "'; model " + name +
