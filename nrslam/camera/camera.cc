@@ -178,9 +178,11 @@ Camera Camera::Resized(int width, int height) const {
   return camera;
 }
 
-std::string Camera::model_name() const {
-  return VisitCameraModel(model_, [](auto model) { return std::string(decltype(model)::kName); });
+std::string CameraModelName(CameraModelId model) {
+  return VisitCameraModel(model, [](auto visited) { return std::string(decltype(visited)::kName); });
 }
+
+std::string Camera::model_name() const { return CameraModelName(model_); }
 
 void Camera::ComputeMaxTheta() {
   if (model_ == CameraModelId::kOcam) {
@@ -410,6 +412,17 @@ void Camera::CheckOcam() const {
   }
 }
 
+std::optional<CameraModelId> CameraModelOfToolName(const std::string& name) {
+  static const std::map<std::string, CameraModelId> models = {{"plumb_bob", CameraModelId::kOpenCv},
+                                                              {"rational_polynomial", CameraModelId::kOpenCv},
+                                                              {"radtan", CameraModelId::kOpenCv},
+                                                              {"equidistant", CameraModelId::kKannalaBrandt},
+                                                              {"fisheye", CameraModelId::kKannalaBrandt}};
+  const auto found = models.find(name);
+  if (found == models.end()) return std::nullopt;
+  return found->second;
+}
+
 void to_json(nlohmann::json& j, const Camera& camera) {
   const auto& p = camera.params();
   j = nlohmann::json{{"model", camera.model_name()}, {"width", camera.width()}, {"height", camera.height()},
@@ -449,19 +462,14 @@ void RejectKeysTheModelDoesNotRead(const nlohmann::json& j, const std::string& m
     if (name == model) known.insert(known.end(), keys.begin(), keys.end());
   }
   if (known.size() == common.size()) {
-    // The names calibration tools give these models (Kalibr, ROS, OpenCV's fisheye module).
-    const std::map<std::string, std::string> other_names = {
-        {"radtan", OpenCvModel::kName},          {"plumb_bob", OpenCvModel::kName},
-        {"rational_polynomial", OpenCvModel::kName}, {"equidistant", KannalaBrandtModel::kName},
-        {"fisheye", KannalaBrandtModel::kName},   {"omni", OcamModel::kName}};
-    const auto other = other_names.find(model);
+    const std::optional<CameraModelId> meant = CameraModelOfToolName(model);
     throw Error("camera: unknown camera model '" + model + "' (known: " + Join(names, ", ") + ")" +
-                (other == other_names.end() ? "" : "; " + model + " is " + other->second + " here"));
+                (meant ? "; " + model + " is " + CameraModelName(*meant) + " here" : ""));
   }
+  // Lens coefficients one key each, as many calibration files write them.
+  const std::set<std::string> coefficients = {"k1", "k2", "k3", "k4", "k5", "k6", "p1", "p2"};
   for (const auto& item : j.items()) {
     if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
-    // Lens coefficients one key each, as many calibration files write them.
-    const std::set<std::string> coefficients = {"k1", "k2", "k3", "k4", "k5", "k6", "p1", "p2"};
     if (coefficients.count(item.key()) > 0) {
       throw Error("camera: unknown key '" + item.key() + "': lens coefficients go in one list, \"distortion\": [k1, k2, "
                   "p1, p2, k3] with model opencv (OpenCV's order), or \"k\": [k0, k1, k2, k3] with model "

@@ -81,6 +81,13 @@ class Camera {
   Eigen::Vector3d KannalaBrandtRay(double mx, double my, const Eigen::Vector3d& newton_ray) const;
 };
 
+// The model's name in sequence.json ("kannala_brandt").
+std::string CameraModelName(CameraModelId model);
+// The model here that a calibration tool's name for a lens model means: ROS's plumb_bob and
+// rational_polynomial and Kalibr's radtan are opencv; equidistant and fisheye (Kalibr, ROS,
+// OpenCV's fisheye module) are kannala_brandt. Nothing for any other name.
+std::optional<CameraModelId> CameraModelOfToolName(const std::string& name);
+
 void to_json(nlohmann::json& j, const Camera& camera);
 // Validates (Check()) and throws Error on unknown model or missing fields.
 void from_json(const nlohmann::json& j, Camera& camera);

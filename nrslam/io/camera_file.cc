@@ -157,8 +157,10 @@ Camera ReadOpenCvCamera(const cv::FileNode& map, std::initializer_list<const cha
       distortion_key.empty() ? std::vector<double>() : EntryNumbers(distortion_node, distortion_key);
   const cv::FileNode model_node = map["distortion_model"];
   const std::string model = model_node.isString() ? Lowercase(static_cast<std::string>(model_node)) : "";
-  const bool fisheye = model == "equidistant" || model == "fisheye" || model == "kannala_brandt";
-  if (!model.empty() && !fisheye && model != "plumb_bob" && model != "radtan" && model != "rational_polynomial") {
+  const std::optional<CameraModelId> named =
+      model == KannalaBrandtModel::kName ? CameraModelId::kKannalaBrandt : CameraModelOfToolName(model);
+  const bool fisheye = named == CameraModelId::kKannalaBrandt;
+  if (!model.empty() && !named) {
     throw Error("unknown distortion_model '" + model +
                 "' (known: plumb_bob, radtan, rational_polynomial, equidistant, fisheye, kannala_brandt)");
   }
