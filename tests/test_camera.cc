@@ -445,6 +445,9 @@ TEST(OpenCvModel, CalibrationFilesAreReadAsOpenCvAndRosWriteThem) {
   std::string unknown = ros;
   unknown.replace(unknown.find("plumb_bob"), 9, "division");
   EXPECT_NE(message(unknown).find("unknown distortion_model 'division'"), std::string::npos);
+  std::string not_finite = ros;
+  not_finite.replace(not_finite.find("-0.30"), 5, ".nan");
+  EXPECT_NE(message(not_finite).find("'distortion_coefficients' holds a value that is not finite"), std::string::npos);
   EXPECT_NE(message("image_width: [640\n").find((folder / "broken.yaml").string()), std::string::npos)
       << "a file OpenCV cannot parse is named";
   std::filesystem::remove_all(folder);

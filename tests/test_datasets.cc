@@ -109,6 +109,15 @@ TEST(DatasetImport, EndomapperSimulatedReversedZDepthAndInvertedPoses) {
   ASSERT_EQ(SequenceReader(out).groundtruth().size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) ExpectSamePose(SequenceReader(out).groundtruth()[i].world_from_camera, Pose(i), 1e-3);
 
+  // A pose the file cannot mean is named, not normalised into one or written as read.
+  std::ofstream(in / "trajectory.csv") << poses << "0;0;0;0;0;0;0;0.1\n";
+  EXPECT_NE(ImportError(options, out).find("trajectory.csv line 4: rX;rY;rZ;rW is not a unit quaternion (length 0.0000)"),
+            std::string::npos);
+  std::ofstream(in / "trajectory.csv") << poses << "0;0;nan;0;0;0;1;0.1\n";
+  EXPECT_NE(ImportError(options, out).find("trajectory.csv line 4 holds a value that is not finite (nan or inf)"),
+            std::string::npos);
+  std::ofstream(in / "trajectory.csv") << poses;
+
   fs::remove(in / "depth" / "aov_image_0002.exr");
   EXPECT_NE(ImportError(options, out).find("missing " + (in / "depth" / "aov_image_0002.exr").string()), std::string::npos);
   fs::remove_all(in);

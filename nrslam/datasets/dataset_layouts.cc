@@ -123,8 +123,12 @@ FrameSource EndomapperSim(const ImportOptions& options) {
     if (v.size() < 7) {
       Fail(options, "trajectory.csv line " + std::to_string(line.line) + ": expected tX;tY;tZ;rX;rY;rZ;rW;time");
     }
-    const Rigid3 camera_from_world(Eigen::Quaterniond(v[6], v[3], v[4], v[5]),
-                                   Eigen::Vector3d(v[0], v[1], v[2]) * options.scene_unit_mm);
+    const Eigen::Quaterniond rotation(v[6], v[3], v[4], v[5]);
+    if (!IsUnitQuaternion(rotation)) {
+      Fail(options, "trajectory.csv line " + std::to_string(line.line) + ": rX;rY;rZ;rW is not a unit quaternion (length " +
+                        FormatFixed(rotation.norm(), 4) + ")");
+    }
+    const Rigid3 camera_from_world(rotation, Eigen::Vector3d(v[0], v[1], v[2]) * options.scene_unit_mm);
     source.world_from_camera.push_back(camera_from_world.Inverse());
   }
   KeepOnePosePerFrame(options, "trajectory.csv", &source);

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <optional>
@@ -97,7 +98,13 @@ std::vector<NumberLine> NumberLines(const ImportOptions& options, const std::str
   std::vector<NumberLine> lines;
   std::string line;
   for (int number = 1; std::getline(file, line); ++number) {
-    if (line.find_first_not_of(" \t\r") != std::string::npos) lines.push_back({number, Numbers(line)});
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::vector<double> numbers = Numbers(line);
+    // strtod reads "nan" and "inf": a pose or an intrinsic made of them would be written as read.
+    if (!std::all_of(numbers.begin(), numbers.end(), [](double value) { return std::isfinite(value); })) {
+      Fail(options, name + " line " + std::to_string(number) + " holds a value that is not finite (nan or inf)");
+    }
+    lines.push_back({number, std::move(numbers)});
   }
   return lines;
 }

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cmath>
 
 namespace nrslam {
 
@@ -54,6 +55,12 @@ struct Rigid3 {
 // precision calibration and pose files are written with.
 inline bool IsRotation(const Eigen::Matrix3d& matrix, double tolerance = 1e-3) {
   return (matrix.transpose() * matrix - Eigen::Matrix3d::Identity()).norm() <= tolerance && matrix.determinant() > 0;
+}
+
+// Whether a quaternion read from a file is a rotation: of unit length to within what a text
+// file's digits lose; a zero, far-off or non-finite one is not normalised into a pose.
+inline bool IsUnitQuaternion(const Eigen::Quaterniond& q, double tolerance = 1e-3) {
+  return std::abs(q.norm() - 1.0) <= tolerance;
 }
 
 // x_a = T_ab * x_b for a pose parameter block; templated for Ceres Jets.

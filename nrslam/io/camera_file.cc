@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -54,6 +55,7 @@ std::vector<double> EntryNumbers(const cv::FileNode& node, const std::string& ke
   for (const cv::FileNode& item : list) {
     if (!item.isReal() && !item.isInt()) throw Error("'" + key + "' holds something that is not a number");
     numbers.push_back(static_cast<double>(item));
+    if (!std::isfinite(numbers.back())) throw Error("'" + key + "' holds a value that is not finite (nan or inf)");
   }
   return numbers;
 }

@@ -45,7 +45,7 @@ std::vector<StampedPose> ReadTum(const std::filesystem::path& path) {
       if (!std::isfinite(value)) throw Error(path.string() + ":" + std::to_string(line_number) + ": non-finite value");
     }
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (std::abs(q.norm() - 1.0) > 1e-3) {
+    if (!IsUnitQuaternion(q)) {
       throw Error(path.string() + ":" + std::to_string(line_number) + ": quaternion is not unit length");
     }
     poses.push_back({v[0], Rigid3(q, Eigen::Vector3d(v[1], v[2], v[3]))});
