@@ -1769,6 +1769,15 @@ TEST(Tools, PreviewOfADamagedSequenceSkipsOnlyTheDamagedFrames) {
   EXPECT_NE(bare, 0);
   EXPECT_NE(bare_log.find("--out " + (folder / "one").string() + ": not an image file name OpenCV writes"),
             std::string::npos) << bare_log;
+  // A scale that would draw nothing, or ask OpenCV for gigabytes, is named, not left to cv::resize.
+  const auto [tiny, tiny_log] =
+      RunCaught(preview + " --frame 1 --scale 0.01 --out " + (folder / "one.png").string(), folder / "tiny.txt");
+  EXPECT_NE(tiny, 0);
+  EXPECT_NE(tiny_log.find("--scale draws the 160x120 frames under 8 px a side"), std::string::npos) << tiny_log;
+  const auto [huge, huge_log] =
+      RunCaught(preview + " --frame 1 --scale 1000 --out " + (folder / "one.png").string(), folder / "huge.txt");
+  EXPECT_NE(huge, 0);
+  EXPECT_NE(huge_log.find("--scale must be in (0, 4]"), std::string::npos) << huge_log;
   std::filesystem::remove_all(folder);
 }
 

@@ -94,7 +94,14 @@ class Preview {
   Preview(const std::string& sequence, const std::vector<std::string>& runs, const nrslam::ErrorViewOptions& options,
           double scale)
       : runs_(runs.begin(), runs.end()), reader_(sequence.empty() ? SequenceOfRuns() : sequence), options_(options),
-        scale_(scale) {}
+        scale_(scale) {
+    // cv::resize's own message for a frame scaled to nothing names neither the option nor a fix.
+    const int width = reader_.info().camera.width(), height = reader_.info().camera.height();
+    if (std::min(width, height) * scale < kMinScaledSide) {
+      throw nrslam::Error("--scale draws the " + std::to_string(width) + "x" +
+                          std::to_string(height) + " frames under " + std::to_string(kMinScaledSide) + " px a side");
+    }
+  }
 
   int frame_count() const { return reader_.frame_count(); }
   double fps() const { return reader_.info().fps; }
@@ -154,6 +161,7 @@ class Preview {
   nrslam::SequenceReader reader_;
   nrslam::ErrorViewOptions options_;
   double scale_;
+  static constexpr int kMinScaledSide = 8;
 };
 
 // A frame of --all, or nothing (said on stderr) when its colour image cannot be read: one
@@ -202,7 +210,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     view_options.Check();
-    if (!(scale > 0)) throw nrslam::Error("--scale must be > 0");
+    // Up to 4, as nrslam_import's: a larger factor is a typo (a percentage) that would ask for gigabytes.
+    if (!(scale > 0 && scale <= 4)) throw nrslam::Error("--scale must be in (0, 4]");
     const bool to_video = fs::path(out).extension() == ".avi";
     // Checked before anything is drawn: OpenCV's own message names neither the file nor a fix.
     if (!all_frames && !cv::haveImageWriter(out)) {
