@@ -205,6 +205,34 @@ TEST(Manifest, DefaultsShortNamesAndRelativePaths) {
   std::filesystem::remove_all(folder);
 }
 
+// --print-options and config.json nest option groups; --set dots them. A manifest takes both,
+// and a group written out merges with the defaults field by field, not as a whole.
+TEST(Manifest, OptionGroupsMayBeWrittenOutOrDotted) {
+  const auto folder = UniqueTempFolder("manifest_groups");
+  const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({
+    "defaults": {"simulate": {"camera.width": 320}, "set": {"deformation": {"k": 2}}},
+    "sequences": [
+      {"name": "a", "preset": "sim-3", "simulate": {"camera": {"height": 240, "calibration": "l.yml"}, "frames": 9},
+       "set": {"tracking": {"rigid": true}, "deformation": {"sigma_factor": 3}}}
+    ]})"));
+  ASSERT_EQ(manifest.sequences.size(), 1u);
+  const std::string lens = "camera.calibration=" + (std::filesystem::absolute(folder) / "l.yml").lexically_normal().string();
+  EXPECT_EQ(manifest.sequences[0].simulate,
+            (std::vector<std::string>{lens, "camera.height=240", "camera.width=320", "frames=9"}));
+  const std::vector<std::string>& set = manifest.sequences[0].assignments;
+  for (const char* assignment : {"deformation.k=2", "deformation.sigma_factor=3", "tracking.rigid=true"}) {
+    EXPECT_NE(std::find(set.begin(), set.end(), assignment), set.end()) << assignment;
+  }
+  const auto error = [&](const std::string& sequence) {
+    return ErrorOf(WriteFile(folder / "bad.json", R"({"sequences": [)" + sequence + "]}"));
+  };
+  const std::string twice = error(R"({"name": "b", "preset": "sim-3", "simulate": {"camera.width": 64, "camera": {"width": 32}}})");
+  EXPECT_NE(twice.find("sequence 1 ('b'): simulate: option 'camera.width' is given twice"), std::string::npos) << twice;
+  const std::string empty = error(R"({"name": "b", "preset": "sim-3", "simulate": {"camera": {}}})");
+  EXPECT_NE(empty.find("option 'camera' is a group"), std::string::npos) << empty;
+  std::filesystem::remove_all(folder);
+}
+
 TEST(Manifest, OnlyKeepsTheNamedSequencesInTheManifestsOrder) {
   const auto folder = UniqueTempFolder("manifest_only");
   const Manifest manifest = LoadManifest(WriteFile(folder / "m.json", R"({

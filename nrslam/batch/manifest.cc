@@ -87,6 +87,20 @@ ExternalResult ParseExternal(const Json& entry, const std::filesystem::path& fol
   return result;
 }
 
+// `entry` (a sequence or the defaults) with its "set" and "simulate" options by dotted names,
+// so that a group written out ({"camera": {"width": 64}}) merges with the defaults field by field.
+Json WithDottedOptions(Json entry, const std::string& context) {
+  for (const char* key : {"set", "simulate"}) {
+    if (!entry.is_object() || !entry.contains(key) || !entry[key].is_object()) continue;
+    try {
+      entry[key] = DottedOptions(entry[key]);
+    } catch (const Error& e) {
+      throw Error(context + ": " + key + ": " + e.what());
+    }
+  }
+  return entry;
+}
+
 // Merges the defaults under an entry: objects ("set", "simulate") key by key, the rest whole.
 Json WithDefaults(const Json& defaults, const Json& entry) {
   Json merged = defaults;
@@ -233,7 +247,7 @@ Manifest LoadManifest(const std::filesystem::path& file) {
   Manifest manifest;
   manifest.file = std::filesystem::absolute(file);
   manifest.description = json.value("description", "");
-  const Json defaults = json.value("defaults", Json::object());
+  const Json defaults = WithDottedOptions(json.value("defaults", Json::object()), where + ", defaults");
   Require(defaults.is_object(), where, "\"defaults\" must be an object");
   std::set<std::string> default_keys = kSequenceKeys;
   for (const char* key : {"name", "path", "preset", "import"}) {
@@ -258,7 +272,8 @@ Manifest LoadManifest(const std::filesystem::path& file) {
       for (const std::string& key : kRunKeys) entry_defaults.erase(key);
     }
     ManifestSequence sequence =
-        ParseSequence(WithDefaults(entry_defaults, entries[i]), manifest.file.parent_path(), context);
+        ParseSequence(WithDefaults(entry_defaults, WithDottedOptions(entries[i], context)), manifest.file.parent_path(),
+                      context);
     Require(names.insert(sequence.name).second, context, "the name '" + sequence.name + "' is used twice");
     manifest.sequences.push_back(std::move(sequence));
   }

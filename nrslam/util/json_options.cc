@@ -171,6 +171,29 @@ std::vector<std::string> LeafPaths(const Json& config) {
   return paths;
 }
 
+namespace {
+
+void AddDotted(const Json& node, const std::string& prefix, Json* dotted) {
+  for (const auto& [key, value] : node.items()) {
+    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    if (value.is_object() && !value.empty()) {
+      AddDotted(value, path, dotted);
+    } else if (dotted->contains(path)) {
+      throw Error("option '" + path + "' is given twice, as a dotted name and as a group's field");
+    } else {
+      (*dotted)[path] = value;
+    }
+  }
+}
+
+}  // namespace
+
+Json DottedOptions(const Json& options) {
+  Json dotted = Json::object();
+  AddDotted(options, "", &dotted);
+  return dotted;
+}
+
 std::string LastName(const std::string& path) { return path.substr(path.rfind('.') + 1); }  // npos + 1 == 0
 
 std::vector<std::string> CloseOptionNames(const std::string& name, const std::vector<std::string>& paths) {

@@ -44,6 +44,12 @@ Json ReadJsonFile(const std::filesystem::path& file);
 // All leaf paths of a JSON object, dotted ("scene.amplitude_mm"), for help and error text.
 std::vector<std::string> LeafPaths(const Json& config);
 
+// `options` with its nested groups spelled as dotted names, {"camera": {"width": 64}} as
+// {"camera.width": 64}, so that an object of options may be written either way (--print-options
+// and config.json nest them, --set dots them). An empty group stays, to be named as one. Throws
+// Error when one option is given both ways.
+Json DottedOptions(const Json& options);
+
 // The last part of a dotted option path ("amplitude_mm"); the path itself when it has no dot.
 std::string LastName(const std::string& path);
 
