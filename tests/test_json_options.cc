@@ -59,6 +59,31 @@ TEST(JsonOptions, UnknownNamesSuggestTheCloseOptions) {
   }
 }
 
+// An options file may name a group's field as --set does; one option given two ways is refused.
+TEST(JsonOptions, AnOptionsFileMayNestGroupsOrDotTheirFields) {
+  const SimOptions nested =
+      OptionsFromJson<SimOptions>(Json::parse(R"({"camera": {"width": 320}, "deformation": {"omega_rad_s": 4}})"), "f");
+  const SimOptions dotted =
+      OptionsFromJson<SimOptions>(Json::parse(R"({"camera.width": 320, "deformation": {"omega_rad_s": 4}})"), "f");
+  EXPECT_EQ(nested.camera.width, 320);
+  EXPECT_EQ(nested.deformation.omega_rad_s, 4.0);
+  EXPECT_EQ(Json(dotted), Json(nested));
+  EXPECT_EQ(DottedOptions(Json::parse(R"({"camera": {"width": 320}, "frames": 9})")),
+            Json::parse(R"({"camera.width": 320, "frames": 9})"));
+  EXPECT_EQ(NestedOptions(Json::parse(R"({"camera.width": 320, "frames": 9})")),
+            Json::parse(R"({"camera": {"width": 320}, "frames": 9})"));
+  const auto error = [](const std::string& text) {
+    return ErrorMessage([&] { OptionsFromJson<SimOptions>(Json::parse(text), "f.json"); });
+  };
+  EXPECT_NE(error(R"({"camera.width": 320, "camera": {"width": 64}})")
+                .find("f.json: option 'camera.width' is given twice, as a dotted name and as a group's field"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"camera": 5, "camera.width": 64})").find("f.json: option 'camera' is given as a value and as a group"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"camera.widht": 320})").find("unknown option 'camera.widht' (did you mean camera.width?)"),
+            std::string::npos);
+}
+
 TEST(JsonOptions, BadValuesAndInvalidResultsAreRejected) {
   EXPECT_THROW(WithAssignments(SimOptions{}, {"frames=many"}), Error);
   EXPECT_THROW(WithAssignments(SimOptions{}, {"frames"}), Error);

@@ -194,6 +194,23 @@ Json DottedOptions(const Json& options) {
   return dotted;
 }
 
+Json NestedOptions(const Json& options) {
+  Json nested = Json::object();
+  // In name order, a value ("camera") comes before the fields of the group it would clash with.
+  for (const auto& [path, value] : DottedOptions(options).items()) {
+    Json* node = &nested;
+    size_t begin = 0;
+    for (size_t dot = path.find('.'); dot != std::string::npos; begin = dot + 1, dot = path.find('.', begin)) {
+      node = &(*node)[path.substr(begin, dot - begin)];
+      if (!node->is_null() && !node->is_object()) {
+        throw Error("option '" + path.substr(0, dot) + "' is given as a value and as a group");
+      }
+    }
+    (*node)[path.substr(begin)] = value;
+  }
+  return nested;
+}
+
 std::string LastName(const std::string& path) { return path.substr(path.rfind('.') + 1); }  // npos + 1 == 0
 
 std::vector<std::string> CloseOptionNames(const std::string& name, const std::vector<std::string>& paths) {

@@ -50,6 +50,10 @@ std::vector<std::string> LeafPaths(const Json& config);
 // Error when one option is given both ways.
 Json DottedOptions(const Json& options);
 
+// The inverse: every dotted name as a nested group, {"camera.width": 64} as {"camera": {"width":
+// 64}}; groups already nested stay. Throws Error when a name is given as a value and as a group.
+Json NestedOptions(const Json& options);
+
 // The last part of a dotted option path ("amplitude_mm"); the path itself when it has no dot.
 std::string LastName(const std::string& path);
 
@@ -87,13 +91,22 @@ T Field(const Json& object, const std::string& key, const std::string& context, 
 void RejectUnknownKeys(const Json& object, const std::vector<std::string>& known, const std::string& context);
 
 // Parses options from JSON on top of `base` (the defaults unless given, e.g. a preset),
-// rejecting unknown keys and values of the wrong kind, then Check()s.
+// rejecting unknown keys and values of the wrong kind, then Check()s. Groups may be nested or
+// their fields named by dotted paths ("camera.width"), as --set names them.
 template <typename Options>
 Options OptionsFromJson(const Json& given, const std::string& context, const Options& base = Options{}) {
   const Json defaults = base;
-  RejectMismatchedOptions(given, defaults, context);
+  Json nested = given;
+  if (given.is_object()) {
+    try {
+      nested = NestedOptions(given);
+    } catch (const Error& e) {
+      throw Error(context + ": " + e.what());
+    }
+  }
+  RejectMismatchedOptions(nested, defaults, context);
   Json merged = defaults;
-  merged.merge_patch(given);
+  merged.merge_patch(nested);
   Options options = merged.get<Options>();
   options.Check();
   return options;
