@@ -197,7 +197,8 @@ Json DottedOptions(const Json& options) {
 Json NestedOptions(const Json& options) {
   Json nested = Json::object();
   // In name order, a value ("camera") comes before the fields of the group it would clash with.
-  for (const auto& [path, value] : DottedOptions(options).items()) {
+  const Json dotted = DottedOptions(options);  // named: items() would not keep a temporary alive
+  for (const auto& [path, value] : dotted.items()) {
     Json* node = &nested;
     size_t begin = 0;
     for (size_t dot = path.find('.'); dot != std::string::npos; begin = dot + 1, dot = path.find('.', begin)) {
