@@ -80,7 +80,7 @@ TEST(JsonOptions, AnOptionsFileMayNestGroupsOrDotTheirFields) {
             std::string::npos);
   EXPECT_NE(error(R"({"camera": 5, "camera.width": 64})").find("f.json: option 'camera' is given as a value and as a group"),
             std::string::npos);
-  EXPECT_NE(error(R"({"camera.widht": 320})").find("unknown option 'camera.widht' (did you mean camera.width?)"),
+  EXPECT_NE(error(R"({"camera.heigt": 240})").find("unknown option 'camera.heigt' (did you mean camera.height?)"),
             std::string::npos);
 }
 
