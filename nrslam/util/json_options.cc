@@ -13,13 +13,17 @@
 namespace nrslam {
 namespace {
 
-void CollectLeafPaths(const Json& node, const std::string& prefix, std::vector<std::string>* out) {
-  if (!node.is_object()) {
-    out->push_back(prefix);
-    return;
-  }
-  for (auto it = node.begin(); it != node.end(); ++it) {
-    CollectLeafPaths(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
+// Every leaf of `node` under its dotted path into `dotted`; an empty group is a leaf.
+void AddDotted(const Json& node, const std::string& prefix, Json* dotted) {
+  for (const auto& [key, value] : node.items()) {
+    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    if (value.is_object() && !value.empty()) {
+      AddDotted(value, path, dotted);
+    } else if (dotted->contains(path)) {
+      throw Error("option '" + path + "' is given twice, as a dotted name and as a group's field");
+    } else {
+      (*dotted)[path] = value;
+    }
   }
 }
 
@@ -165,33 +169,19 @@ std::vector<std::string> ChangedAssignments(const Json& base, const Json& change
   return assignments;
 }
 
-std::vector<std::string> LeafPaths(const Json& config) {
-  std::vector<std::string> paths;
-  CollectLeafPaths(config, "", &paths);
-  return paths;
-}
-
-namespace {
-
-void AddDotted(const Json& node, const std::string& prefix, Json* dotted) {
-  for (const auto& [key, value] : node.items()) {
-    const std::string path = prefix.empty() ? key : prefix + "." + key;
-    if (value.is_object() && !value.empty()) {
-      AddDotted(value, path, dotted);
-    } else if (dotted->contains(path)) {
-      throw Error("option '" + path + "' is given twice, as a dotted name and as a group's field");
-    } else {
-      (*dotted)[path] = value;
-    }
-  }
-}
-
-}  // namespace
 
 Json DottedOptions(const Json& options) {
   Json dotted = Json::object();
   AddDotted(options, "", &dotted);
   return dotted;
+}
+
+std::vector<std::string> LeafPaths(const Json& config) {
+  // '.' sorts before every character of a name, so the dotted names keep the groups' order.
+  const Json dotted = DottedOptions(config);
+  std::vector<std::string> paths;
+  for (const auto& item : dotted.items()) paths.push_back(item.key());
+  return paths;
 }
 
 Json NestedOptions(const Json& options) {
